@@ -1,0 +1,32 @@
+#include "clothlab/euler.hpp"
+
+#include "clothlab/world.hpp"
+
+namespace clothlab {
+
+namespace {
+
+// Both Euler methods: evaluate forces once at the current state, then move every particle
+// with the one-particle kernel. `kernel` is a plain function, inlined at link time.
+template <class Kernel>
+void euler_advance(World& world, double dt, Kernel kernel) {
+  Particles& p = world.particles;
+  world.compute_forces(p.x, p.v, p.f);
+  for (Index i = 0; i < p.size(); ++i) {
+    const PointState next = kernel(p.x.col(i), p.v.col(i), p.f.col(i), p.inv_m[i], dt);
+    p.x.col(i) = next.r;
+    p.v.col(i) = next.v;
+  }
+}
+
+}  // namespace
+
+void ExplicitEuler::advance(World& world, double dt) const {
+  euler_advance(world, dt, explicit_euler_step);
+}
+
+void SymplecticEuler::advance(World& world, double dt) const {
+  euler_advance(world, dt, symplectic_euler_step);
+}
+
+}  // namespace clothlab

@@ -1,0 +1,31 @@
+// integrator.hpp: what advances the particles by one time step.
+//
+// An integrator asks the world for forces (as often as its method needs: once for Euler,
+// several times for multi-stage methods) and moves positions and velocities forward by dt.
+// Each method lives in its own file (euler.cpp, ...) and is chosen by name in the scene.
+#pragma once
+
+#include <memory>
+#include <span>
+#include <string_view>
+
+namespace clothlab {
+
+class World;
+
+class Integrator {
+ public:
+  virtual ~Integrator() = default;
+  virtual std::string_view name() const = 0;
+
+  // Advances world.particles by dt [s]. Evaluates forces through world.compute_forces.
+  virtual void advance(World& world, double dt) const = 0;
+};
+
+// The names a scene may give in [integrator] method = "...".
+std::span<const std::string_view> integrator_names();
+
+// The integrator called `name`, or nullptr when there is none by that name.
+std::unique_ptr<Integrator> make_integrator(std::string_view name);
+
+}  // namespace clothlab

@@ -1,0 +1,326 @@
+#include "clothlab/scene.hpp"
+
+#include <algorithm>
+#include <cctype>
+#include <cmath>
+#include <fstream>
+#include <sstream>
+#include <vector>
+
+#include <fmt/format.h>
+#include <toml++/toml.h>
+
+#include "clothlab/scene_reader.hpp"
+#include "clothlab/scene_tables.hpp"
+
+namespace clothlab {
+
+SceneError::SceneError(const std::string& source, long line, long column,
+                       const std::string& message)
+    : std::runtime_error(fmt::format("{}:{}:{}: {}", source, line, column, message)),
+      source_(source),
+      line_(line),
+      column_(column),
+      message_(message) {}
+
+long Scene::step_count() const {
+  // duration / dt rounded to the nearest whole step (1.0 / 0.01 is 100.00000000000001).
+  return std::max(1L, std::lround(duration / dt));
+}
+
+namespace {
+
+const toml::table& as_table(const void* node) {
+  return *static_cast<const toml::table*>(node);
+}
+
+[[noreturn]] void fail_at(const std::string& source, const toml::source_region& where,
+                          const std::string& message) {
+  throw SceneError(source, static_cast<long>(where.begin.line),
+                   static_cast<long>(where.begin.column), message);
+}
+
+std::string_view type_name(const toml::node& node) {
+  switch (node.type()) {
+    case toml::node_type::string:
+      return "a string";
+    case toml::node_type::integer:
+      return "an integer";
+    case toml::node_type::floating_point:
+      return "a number";
+    case toml::node_type::boolean:
+      return "a boolean";
+    case toml::node_type::array:
+      return "an array";
+    case toml::node_type::table:
+      return "a table";
+    default:
+      return "a date or time";
+  }
+}
+
+// Calls fn(name) for each name in a list separated by spaces.
+template <class Fn>
+void for_each_name(std::string_view names, Fn fn) {
+  while (!names.empty()) {
+    const size_t end = std::min(names.find(' '), names.size());
+    if (end > 0) fn(names.substr(0, end));
+    names.remove_prefix(std::min(end + 1, names.size()));
+  }
+}
+
+bool is_one_of(std::string_view name, std::string_view names) {
+  bool found = false;
+  for_each_name(names, [&](std::string_view n) { found = found || n == name; });
+  return found;
+}
+
+std::string comma_list(std::string_view names) {
+  std::string list;
+  for_each_name(names, [&](std::string_view n) {
+    if (!list.empty()) list += ", ";
+    list += n;
+  });
+  return list;
+}
+
+std::string describe_range(const Range& r) {
+  std::string text;
+  const bool has_min = std::isfinite(r.min);
+  const bool has_max = std::isfinite(r.max);
+  if (has_min && has_max) {
+    text = fmt::format("a number from {} to {}", r.min, r.max);
+  } else if (has_min) {
+    text = fmt::format("a number {} {}", r.min_exclusive ? ">" : ">=", r.min);
+  } else {
+    text = "a finite number";
+  }
+  if (!r.unit.empty()) text += fmt::format(" [{}]", r.unit);
+  return text;
+}
+
+}  // namespace
+
+// --- SceneTable ------------------------------------------------------------------------------
+
+SceneTable::SceneTable(const void* node, std::string display_name, const std::string& source)
+    : node_(node), name_(std::move(display_name)), source_(source) {}
+
+void SceneTable::fail(std::string_view key, const std::string& message) const {
+  const toml::table& table = as_table(node_);
+  const toml::node* value = table.get(key);
+  fail_at(source_, value ? value->source() : table.source(), message);
+}
+
+namespace {
+
+// Reads one number from `node`, checking type, finiteness and range.
+double checked_number(const toml::node& node, const std::string& source, std::string_view what,
+                      const Range& range) {
+  double x = 0.0;
+  if (const auto* i = node.as_integer()) {
+    x = static_cast<double>(i->get());
+  } else if (const auto* d = node.as_floating_point()) {
+    x = d->get();
+  } else {
+    fail_at(source, node.source(),
+            fmt::format("{} is {}; expected {}", what, type_name(node), describe_range(range)));
+  }
+  if (!std::isfinite(x)) {
+    fail_at(source, node.source(),
+            fmt::format("{} is {}; expected {}", what, x, describe_range(range)));
+  }
+  const bool below = range.min_exclusive ? !(x > range.min) : !(x >= range.min);
+  if (below || x > range.max) {
+    fail_at(source, node.source(),
+            fmt::format("{} is {}; expected {}", what, x, describe_range(range)));
+  }
+  return x;
+}
+
+}  // namespace
+
+double SceneTable::number(std::string_view key, const Range& range, double fallback) {
+  const toml::node* node = as_table(node_).get(key);
+  if (!node) return fallback;
+  return checked_number(*node, source_, fmt::format("'{}' in {}", key, name_), range);
+}
+
+double SceneTable::required_number(std::string_view key, const Range& range) {
+  if (!as_table(node_).contains(key)) {
+    fail(key,
+         fmt::format("{} has no '{}'; expected {} = {}", name_, key, key, describe_range(range)));
+  }
+  return number(key, range, 0.0);
+}
+
+Vec3 SceneTable::vec3(std::string_view key, std::string_view unit, const Vec3& fallback) {
+  const toml::node* node = as_table(node_).get(key);
+  if (!node) return fallback;
+  const toml::array* array = node->as_array();
+  const std::string expected = fmt::format("an array of three numbers [x, y, z] [{}]", unit);
+  if (!array) {
+    fail_at(source_, node->source(),
+            fmt::format("'{}' in {} is {}; expected {}", key, name_, type_name(*node), expected));
+  }
+  if (array->size() != 3) {
+    fail_at(source_, node->source(),
+            fmt::format("'{}' in {} has {} elements; expected {}", key, name_, array->size(),
+                        expected));
+  }
+  Vec3 result;
+  for (int k = 0; k < 3; ++k) {
+    result[k] = checked_number((*array)[static_cast<size_t>(k)], source_,
+                               fmt::format("'{}[{}]' in {}", key, k, name_), Range::any(unit));
+  }
+  return result;
+}
+
+Vec3 SceneTable::required_vec3(std::string_view key, std::string_view unit) {
+  if (!as_table(node_).contains(key)) {
+    fail(key, fmt::format("{} has no '{}'; expected {} = [x, y, z] [{}]", name_, key, key, unit));
+  }
+  return vec3(key, unit, Vec3::Zero());
+}
+
+std::optional<std::string> SceneTable::string(std::string_view key) {
+  const toml::node* node = as_table(node_).get(key);
+  if (!node) return std::nullopt;
+  if (const auto* s = node->as_string()) return s->get();
+  fail_at(source_, node->source(),
+          fmt::format("'{}' in {} is {}; expected a string", key, name_, type_name(*node)));
+}
+
+std::string SceneTable::choice(std::string_view key, const std::vector<std::string_view>& choices,
+                               std::string_view fallback) {
+  const std::optional<std::string> value = string(key);
+  if (!value) return std::string(fallback);
+  for (std::string_view c : choices) {
+    if (*value == c) return *value;
+  }
+  fail(key, fmt::format("unknown {} '{}' in {}; expected one of: \"{}\"", key, *value, name_,
+                        fmt::join(choices, "\", \"")));
+}
+
+void SceneTable::check_keys(std::string_view known) const {
+  for (auto&& [key, value] : as_table(node_)) {
+    if (is_one_of(key.str(), known)) continue;
+    const std::string guess = nearest_name(key.str(), known);
+    fail_at(source_, key.source(),
+            fmt::format("unknown key '{}' in {}{}; expected one of: {}", key.str(), name_,
+                        guess.empty() ? "" : fmt::format(" (did you mean '{}'?)", guess),
+                        comma_list(known)));
+  }
+}
+
+std::string nearest_name(std::string_view typo, std::string_view candidates) {
+  // Levenshtein distance: the fewest single-letter edits that turn one word into the other.
+  auto distance = [](std::string_view a, std::string_view b) {
+    std::vector<size_t> row(b.size() + 1);
+    for (size_t j = 0; j <= b.size(); ++j)
+      row[j] = j;
+    for (size_t i = 1; i <= a.size(); ++i) {
+      size_t diagonal = row[0];
+      row[0] = i;
+      for (size_t j = 1; j <= b.size(); ++j) {
+        const size_t substitute = diagonal + (a[i - 1] == b[j - 1] ? 0 : 1);
+        diagonal = row[j];
+        row[j] = std::min({row[j] + 1, row[j - 1] + 1, substitute});
+      }
+    }
+    return row[b.size()];
+  };
+  std::string best;
+  size_t best_distance = 3;  // more than two edits away is no longer a typo
+  for_each_name(candidates, [&](std::string_view name) {
+    const size_t d = distance(typo, name);
+    if (d < best_distance) {
+      best_distance = d;
+      best = name;
+    }
+  });
+  return best;
+}
+
+// --- Reading a whole scene -------------------------------------------------------------------
+
+Scene parse_scene(std::string_view text, const std::string& source) {
+  toml::table root;
+  try {
+    root = toml::parse(text, source);
+  } catch (const toml::parse_error& error) {
+    // toml++ says e.g. "Error while parsing array: expected comma or closing ']', saw 'm'",
+    // which already names what was expected.
+    std::string what(error.description());
+    if (!what.empty()) what[0] = static_cast<char>(std::tolower(what[0]));
+    fail_at(source, error.source(), "invalid TOML: " + what);
+  }
+
+  Scene scene;
+  scene.source = source;
+  const toml::source_region top{{1, 1}, {1, 1}, nullptr};
+
+  // Every top-level key is a table this build knows, or the scene's title.
+  for (auto&& [key, value] : root) {
+    if (key.str() == "title") {
+      if (!value.is_string()) {
+        fail_at(source, value.source(),
+                fmt::format("'title' is {}; expected a string", type_name(value)));
+      }
+      scene.title = value.as_string()->get();
+      continue;
+    }
+    const SceneTableKind* kind = find_scene_table(key.str());
+    if (!kind) {
+      const std::string guess = nearest_name(key.str(), scene_table_names());
+      fail_at(source, key.source(),
+              fmt::format("unknown table [{}]{}; expected one of: {}", key.str(),
+                          guess.empty() ? "" : fmt::format(" (did you mean [{}]?)", guess),
+                          comma_list(scene_table_names())));
+    }
+    const bool is_array_of_tables = value.is_array_of_tables();
+    if (kind->repeated ? !is_array_of_tables : !value.is_table()) {
+      fail_at(source, value.source(),
+              kind->repeated ? fmt::format("'{}' is {}; expected one or more [[{}]] tables",
+                                           key.str(), type_name(value), key.str())
+                             : fmt::format("'{}' is {}; expected a [{}] table", key.str(),
+                                           type_name(value), key.str()));
+    }
+  }
+
+  // Read the tables in the order the engine needs them (particles before the effects on them).
+  for (const SceneTableKind& kind : scene_table_kinds()) {
+    const toml::node* node = root.get(kind.name);
+    if (!node) {
+      if (kind.required) {
+        fail_at(source, top,
+                fmt::format("the scene has no [{}] table; expected {}", kind.name, kind.summary));
+      }
+      continue;
+    }
+    if (kind.repeated) {
+      const toml::array& array = *node->as_array();
+      for (size_t i = 0; i < array.size(); ++i) {
+        SceneTable table(array[i].as_table(), fmt::format("[[{}]] #{}", kind.name, i + 1), source);
+        table.check_keys(kind.keys);
+        kind.read(table, scene);
+      }
+    } else {
+      SceneTable table(node->as_table(), fmt::format("[{}]", kind.name), source);
+      table.check_keys(kind.keys);
+      kind.read(table, scene);
+    }
+  }
+  check_scene(scene, [&](const std::string& message) { fail_at(source, top, message); });
+  return scene;
+}
+
+Scene load_scene_file(const std::filesystem::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw SceneError(path.string(), 1, 1, "cannot open the file; expected a readable scene");
+  std::ostringstream text;
+  text << in.rdbuf();
+  return parse_scene(text.str(), path.string());
+}
+
+}  // namespace clothlab

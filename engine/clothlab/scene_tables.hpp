@@ -1,0 +1,31 @@
+// scene_tables.hpp: the tables a scene file may hold, and the function that reads each.
+#pragma once
+
+#include <functional>
+#include <span>
+#include <string>
+#include <string_view>
+
+#include "clothlab/scene.hpp"
+#include "clothlab/scene_reader.hpp"
+
+namespace clothlab {
+
+struct SceneTableKind {
+  std::string_view name;     // as written in the file: "gravity" for [gravity]
+  bool repeated;             // true: [[name]], one table per item (e.g. one per particle)
+  bool required;             // a scene without it is an error
+  std::string_view keys;     // every key the table may hold, separated by spaces
+  std::string_view summary;  // what the table holds, quoted when it is missing
+  void (*read)(SceneTable& table, Scene& scene);
+};
+
+// Every table, in the order they are read: parts first, then effects, then run settings.
+std::span<const SceneTableKind> scene_table_kinds();
+const SceneTableKind* find_scene_table(std::string_view name);
+std::string scene_table_names();  // "title particle gravity ...": every top-level name
+
+// Checks that need the whole scene (e.g. "at least one particle"); calls fail(message).
+void check_scene(const Scene& scene, const std::function<void(const std::string&)>& fail);
+
+}  // namespace clothlab

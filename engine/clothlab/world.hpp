@@ -1,0 +1,48 @@
+// world.hpp: the particles, the effects a scene named, and the step that ties them together.
+//
+// One step, in the lecture's order:
+//   1. clear the force accumulators;
+//   2. every force effect adds its forces;
+//   3. the integrator advances positions and velocities (re-evaluating 1-2 if it needs to);
+//   4. every post-step effect applies (pins, collisions, ...);
+//   5. the guard checks that the state is still finite and bounded.
+#pragma once
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "clothlab/effect.hpp"
+#include "clothlab/guard.hpp"
+#include "clothlab/integrator.hpp"
+#include "clothlab/particles.hpp"
+
+namespace clothlab {
+
+class World {
+ public:
+  Particles particles;
+  std::vector<std::unique_ptr<ForceEffect>> force_effects;
+  std::vector<std::unique_ptr<PostStepEffect>> post_step_effects;
+  std::unique_ptr<Integrator> integrator;
+  Guard guard;
+
+  double t = 0.0;  // simulated time [s]
+  long steps = 0;  // steps taken so far
+
+  // Takes one step of dt [s] (steps 1-5 above).
+  void step(double dt);
+
+  // Steps 1-2 at an arbitrary state: f = sum of every force effect at (x, v) [N].
+  void compute_forces(const Matrix3X& x, const Matrix3X& v, Matrix3X& f) const;
+
+  // Diagnostics of the current state.
+  double kinetic_energy() const;    // sum of 1/2 m |v|^2 [J] (pinned particles do not move)
+  double potential_energy() const;  // sum over force effects [J]
+  Vec3 momentum() const;            // sum of m v [kg m/s]
+
+  // "gravity, gravitation; symplectic-euler": what a report or an error names as in play.
+  std::string effects_in_play() const;
+};
+
+}  // namespace clothlab
