@@ -1,0 +1,808 @@
+// grade.cpp: `clothlab grade`, the test grader.
+//
+// doctest runs all cases in one process, so one crash or endless loop would lose every grade
+// after it. The grader therefore lists the cases of a grading binary, then runs each in its own
+// process group with a real timeout, and reads the line protocol printed by the binary's
+// "clothlab" reporter (tests/grade/grade_main.cpp describes it).
+#include "app/grade.hpp"
+
+#include <fcntl.h>
+#include <poll.h>
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <fmt/color.h>
+#include <fmt/core.h>
+#include <CLI/CLI.hpp>
+
+#include <algorithm>
+#include <cerrno>
+#include <chrono>
+#include <cmath>
+#include <csignal>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <memory>
+#include <string>
+#include <string_view>
+#include <system_error>
+#include <thread>
+#include <vector>
+
+namespace clothlab::app {
+namespace {
+
+namespace fs = std::filesystem;
+using Clock = std::chrono::steady_clock;
+using Fields = std::vector<std::string>;
+
+struct Options {
+  std::string impl = "student";
+  std::string exercise;  // "ex01" or "ex01.2"; empty for all
+  bool list = false;
+  double timeout = 10;  // per case [s]
+  std::string results;  // Gradescope results.json
+  std::string junit;
+  bool require_full = false;
+  bool require_zero = false;
+  std::string binary;  // hidden: grade this doctest binary instead of grade-<impl>
+};
+
+// One grading test case: what the listing says, then how its run went.
+struct Case {
+  std::string suite, name, file, exercise;
+  int line = 0;
+  int points = 0;
+
+  bool done = false;
+  bool passed = false;
+  bool not_started = false;  // failed on the stub's NotImplemented
+  std::string status = "not run";
+  std::string message;  // the first failure, with its INFO/CAPTURE hints
+  std::string output;   // what the case printed itself
+  double seconds = 0;
+};
+
+[[noreturn]] void fail(int exit_code, const std::string& message) {
+  std::cout << std::flush;
+  std::cerr << "clothlab grade: " << message << "\n";
+  throw CLI::RuntimeError(exit_code);
+}
+
+// --- Running one process with a real timeout ------------------------------------------------
+
+volatile std::sig_atomic_t g_interrupted = 0;
+extern "C" void on_interrupt(int) {
+  g_interrupted = 1;
+}
+
+// While grading, Ctrl-C (or a TERM from an autograder) stops after killing the running case,
+// so no orphan keeps running and the results written so far stay valid.
+class InterruptGuard {
+ public:
+  InterruptGuard() {
+    struct sigaction sa {};
+    sa.sa_handler = on_interrupt;
+    sigemptyset(&sa.sa_mask);
+    sa.sa_flags = 0;  // no SA_RESTART: poll() must return EINTR so we notice at once
+    sigaction(SIGINT, &sa, &old_int_);
+    sigaction(SIGTERM, &sa, &old_term_);
+  }
+  ~InterruptGuard() {
+    sigaction(SIGINT, &old_int_, nullptr);
+    sigaction(SIGTERM, &old_term_, nullptr);
+  }
+  InterruptGuard(const InterruptGuard&) = delete;
+  InterruptGuard& operator=(const InterruptGuard&) = delete;
+
+ private:
+  struct sigaction old_int_ {};
+  struct sigaction old_term_ {};
+};
+
+struct ProcessResult {
+  std::string output;  // stdout and stderr, interleaved as written
+  int exit_code = 0;   // meaningful when signal == 0 and the run was not cut off
+  int signal = 0;
+  bool timed_out = false;
+  bool interrupted = false;
+};
+
+constexpr std::size_t kMaxOutput = 1 << 20;  // keep at most 1 MiB of a chatty case's output
+
+ProcessResult run_process(const std::vector<std::string>& args, double timeout) {
+  // Built before fork(): the child may only make async-signal-safe calls.
+  std::vector<char*> argv;
+  for (const auto& a : args)
+    argv.push_back(const_cast<char*>(a.c_str()));
+  argv.push_back(nullptr);
+
+  int fds[2];
+  if (pipe2(fds, O_CLOEXEC) != 0) throw std::system_error(errno, std::generic_category(), "pipe");
+  const pid_t pid = fork();
+  if (pid < 0) throw std::system_error(errno, std::generic_category(), "fork");
+  if (pid == 0) {
+    setpgid(0, 0);  // its own process group: a timeout kills whatever the case started too
+    // No terminal input: a background process group reading it would be stopped, not fail.
+    const int null_fd = open("/dev/null", O_RDONLY);
+    if (null_fd >= 0) dup2(null_fd, STDIN_FILENO);
+    dup2(fds[1], STDOUT_FILENO);
+    dup2(fds[1], STDERR_FILENO);
+    execv(argv[0], argv.data());
+    const char message[] = "clothlab grade: cannot execute the test binary\n";
+    [[maybe_unused]] auto ignored = write(STDERR_FILENO, message, sizeof message - 1);
+    _exit(127);
+  }
+  setpgid(pid, pid);  // also here, so the kill below cannot race the child's own call
+  close(fds[1]);
+
+  ProcessResult result;
+  const auto deadline = Clock::now() + std::chrono::duration<double>(timeout);
+  auto time_left_ms = [&] {
+    const auto left = std::chrono::ceil<std::chrono::milliseconds>(deadline - Clock::now());
+    return std::max<long>(0, static_cast<long>(left.count()));
+  };
+  auto stop = [&](bool& reason) {
+    kill(-pid, SIGKILL);
+    reason = true;
+  };
+
+  // Read until end of file (the case and anything it started closed the pipe) or the deadline.
+  char buffer[4096];
+  for (;;) {
+    if (g_interrupted) {
+      stop(result.interrupted);
+      break;
+    }
+    const long left = time_left_ms();
+    if (left == 0) {
+      stop(result.timed_out);
+      break;
+    }
+    pollfd p{fds[0], POLLIN, 0};
+    const int ready = poll(&p, 1, static_cast<int>(std::min<long>(left, 1000)));
+    if (ready <= 0) continue;  // timeout slice or EINTR: check the deadline and the flag again
+    const ssize_t got = read(fds[0], buffer, sizeof buffer);
+    if (got < 0 && errno == EINTR) continue;
+    if (got <= 0) break;
+    if (result.output.size() < kMaxOutput) result.output.append(buffer, static_cast<size_t>(got));
+  }
+  close(fds[0]);
+
+  // The pipe can close before the process ends: wait for it, still under the deadline.
+  int status = 0;
+  for (;;) {
+    const pid_t done = waitpid(pid, &status, WNOHANG);
+    if (done == pid) break;
+    if (done < 0 && errno != EINTR) break;
+    if (!result.timed_out && !result.interrupted) {
+      if (g_interrupted)
+        stop(result.interrupted);
+      else if (time_left_ms() == 0)
+        stop(result.timed_out);
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  }
+  if (WIFSIGNALED(status)) result.signal = WTERMSIG(status);
+  if (WIFEXITED(status)) result.exit_code = WEXITSTATUS(status);
+  return result;
+}
+
+// The signals a test process typically dies of, and what usually causes each.
+struct SignalInfo {
+  int number;
+  const char* name;
+  const char* hint;
+};
+constexpr SignalInfo kSignals[] = {
+    {SIGSEGV, "SIGSEGV", "memory the program does not own: an index out of range?"},
+    {SIGBUS, "SIGBUS", "memory the program does not own: an index out of range?"},
+    {SIGFPE, "SIGFPE", "an integer division by zero?"},
+    {SIGABRT, "SIGABRT", "a failed assert(), or an exception thrown where none may be?"},
+    {SIGILL, "SIGILL", ""},
+    {SIGKILL, "SIGKILL", "killed from outside: out of memory?"},
+    {SIGTERM, "SIGTERM", "stopped from outside"},
+};
+
+SignalInfo signal_info(int sig) {
+  for (const SignalInfo& s : kSignals) {
+    if (s.number == sig) return s;
+  }
+  return {sig, "another signal", ""};
+}
+
+// The signal a case died of. doctest reports a crash, then re-raises the signal; under a
+// sanitizer, the sanitizer's handler may exit with a code instead, so the report alone counts too.
+SignalInfo crash_signal(int sig, const std::string& reported) {
+  if (sig != 0) return signal_info(sig);
+  for (const SignalInfo& s : kSignals) {
+    if (reported.starts_with(s.name)) return s;
+  }
+  return {0, "another signal", ""};
+}
+
+// --- The line protocol ------------------------------------------------------------------------
+
+constexpr std::string_view kTag = "@clothlab\t";
+
+Fields split_event(std::string_view line) {
+  Fields fields(1);
+  for (std::size_t i = 0; i < line.size(); ++i) {
+    const char c = line[i];
+    if (c == '\t') {
+      fields.emplace_back();
+    } else if (c == '\\' && i + 1 < line.size()) {
+      const char e = line[++i];
+      fields.back() += e == 't' ? '\t' : e == 'n' ? '\n' : e == 'r' ? '\r' : e;
+    } else {
+      fields.back() += c;
+    }
+  }
+  return fields;
+}
+
+// Splits a binary's output into reporter events and whatever the test printed itself.
+void parse_output(const std::string& text, std::vector<Fields>& events, std::string& other) {
+  std::size_t begin = 0;
+  while (begin < text.size()) {
+    std::size_t end = text.find('\n', begin);
+    if (end == std::string::npos) end = text.size();
+    const std::string_view line(text.data() + begin, end - begin);
+    // A case may print without a final newline, so the tag can start mid-line.
+    const std::size_t at = line.find(kTag);
+    if (at == std::string_view::npos) {
+      other.append(line).append("\n");
+    } else {
+      if (at > 0) other.append(line.substr(0, at)).append("\n");
+      events.push_back(split_event(line.substr(at + kTag.size())));
+    }
+    begin = end + 1;
+  }
+}
+
+// --- Exercises, lessons and messages ---------------------------------------------------------
+
+// An exercise ID: "ex01.3", or with lesson_only "ex01". (Parsed by hand: g++ 12 warns inside
+// <regex> when built with the sanitizers.)
+bool is_exercise_id(std::string_view id, bool lesson_only) {
+  auto digits = [](std::string_view d) {
+    return !d.empty() &&
+           std::all_of(d.begin(), d.end(), [](char c) { return c >= '0' && c <= '9'; });
+  };
+  if (!id.starts_with("ex")) return false;
+  const auto dot = id.find('.');
+  if (dot == std::string_view::npos) return lesson_only && digits(id.substr(2));
+  return digits(id.substr(2, dot - 2)) && digits(id.substr(dot + 1));
+}
+
+// "ex01.3 explicit Euler ..." -> "ex01.3"; a case without an ID counts under its suite.
+std::string exercise_of(const std::string& name, const std::string& suite) {
+  const std::string first_word = name.substr(0, name.find_first_of(" \t"));
+  if (is_exercise_id(first_word, false)) return first_word;
+  return suite.empty() ? "(no exercise)" : suite;
+}
+
+// "ex01.3" -> "1.3", as the lessons number their exercises.
+std::string number_of(const std::string& exercise) {
+  if (!is_exercise_id(exercise, true)) return exercise;
+  const auto dot = exercise.find('.');
+  const std::string part = dot == std::string::npos ? "" : exercise.substr(dot);
+  return std::to_string(std::stoi(exercise.substr(2, dot - 2))) + part;
+}
+
+// "see lessons/01-particles-and-euler/README.md, Exercise 1.3"
+std::string lesson_hint(const std::string& exercise) {
+  if (!is_exercise_id(exercise, true)) return "";
+  const std::string prefix = exercise.substr(2, exercise.find('.') - 2) + "-";  // "01-"
+  std::string lesson = "lessons/" + prefix + "*/README.md";
+  std::error_code ec;
+  for (const auto& entry : fs::directory_iterator(fs::path(CLOTHLAB_SOURCE_DIR) / "lessons", ec)) {
+    const std::string folder = entry.path().filename().string();
+    if (entry.is_directory() && folder.starts_with(prefix)) {
+      lesson = "lessons/" + folder + "/README.md";
+    }
+  }
+  return "see " + lesson + ", Exercise " + number_of(exercise);
+}
+
+std::string relative_path(const std::string& file) {
+  const std::string root = std::string(CLOTHLAB_SOURCE_DIR) + "/";
+  return file.starts_with(root) ? file.substr(root.size()) : file;
+}
+
+// The exercise a stub's NotImplemented names ("exercise ex01.2 is not implemented yet: ..."),
+// or "" when the text is something else.
+std::string not_implemented_in(const std::string& text) {
+  const auto end = text.find(" is not implemented yet");
+  const auto begin = text.rfind("exercise ", end);
+  if (end == std::string::npos || begin == std::string::npos) return "";
+  return text.substr(begin + 9, end - begin - 9);
+}
+
+// fail FILE LINE MACRO EXPRESSION VALUES CONTEXT...
+std::string describe_failure(const Fields& e) {
+  std::string s = fmt::format("{}:{}: ", relative_path(e[1]), e[2]);
+  if (e[4].empty()) {
+    s += e[5];  // FAIL("message")
+  } else {
+    s += fmt::format("{}( {} ) failed", e[3], e[4]);
+    // A bare "false" says nothing the expression does not; the INFO lines below say more.
+    if (e[5] != "false" && e[5] != e[4]) s += "\n  values: " + e[5];
+  }
+  for (std::size_t i = 6; i < e.size(); ++i)
+    s += "\n  " + e[i];
+  return s;
+}
+
+// exception throw|crash TEXT CONTEXT...
+std::string describe_exception(const Fields& e) {
+  std::string s = (e[1] == "crash" ? "the process crashed: " : "threw an exception: ") + e[2];
+  for (std::size_t i = 3; i < e.size(); ++i)
+    s += "\n  " + e[i];
+  return s;
+}
+
+// Decides a case's status from how its process ended and what its reporter said.
+void judge(Case& c, const ProcessResult& run, const std::string& binary, double timeout) {
+  std::vector<Fields> events;
+  parse_output(run.output, events, c.output);
+
+  int starts = 0;
+  bool ended = false;
+  bool reported_pass = false;
+  std::string first_failure;
+  std::string missing;  // the exercise a NotImplemented named
+  std::string crash;    // what doctest said when it caught a crash signal
+  for (Fields& e : events) {
+    // The fewest fields each event has, so that a line cut short cannot crash the grader.
+    const std::size_t fields = e[0] == "fail" ? 6 : e[0] == "note" ? 4 : 3;
+    if (e.size() < fields) e.resize(fields);
+    if (e[0] == "start") {
+      ++starts;
+    } else if (e[0] == "fail" || e[0] == "exception") {
+      const bool is_fail = e[0] == "fail";
+      if (first_failure.empty())
+        first_failure = is_fail ? describe_failure(e) : describe_exception(e);
+      if (missing.empty()) missing = not_implemented_in(is_fail ? e[5] : e[2]);
+      if (!is_fail && e[1] == "crash") crash = e[2];
+    } else if (e[0] == "note") {
+      c.output += fmt::format("note: {}\n", e[3]);
+    } else if (e[0] == "end") {
+      ended = true;
+      reported_pass = e[1] == "passed";
+    }
+  }
+
+  c.done = true;
+  c.message = first_failure;
+  if (run.interrupted) {
+    c.done = false;
+    c.status = "not run (interrupted)";
+  } else if (run.timed_out) {
+    c.status = fmt::format("timed out after {:g} s", timeout);
+    c.message = fmt::format("the case did not finish within {:g} s: an endless loop?", timeout) +
+                (first_failure.empty() ? "" : "\nbefore that, " + first_failure);
+  } else if (run.signal != 0 || !crash.empty()) {
+    const SignalInfo sig = crash_signal(run.signal, crash);
+    c.status = fmt::format("crashed: {}", sig.name);
+    if (c.message.empty())
+      c.message = fmt::format("the process was killed by signal {}", run.signal);
+    if (*sig.hint != '\0') c.message += fmt::format("\n{}", sig.hint);
+  } else if (starts == 0) {
+    c.status = "failed: no test case ran";
+    c.message =
+        "the binary ran no case named \"" + c.name + "\" (it was listed, so this is never a pass)";
+  } else if (starts > 1) {
+    c.status = fmt::format("failed: the name matched {} cases", starts);
+    c.message = "rename the case: its name must select it alone";
+  } else if (!ended) {
+    c.status = fmt::format("exited with code {} before reporting a result", run.exit_code);
+    if (c.message.empty()) c.message = c.status + " (a call to exit()?)";
+  } else if (reported_pass && run.exit_code == 0) {
+    c.passed = true;
+    c.status = "passed";
+  } else if (!missing.empty() && missing == c.exercise) {
+    c.not_started = true;
+    c.status = "not started";
+  } else {
+    c.status = "failed";
+    if (!missing.empty())
+      c.message = "this test also needs " + missing + ", which is not started yet";
+    if (c.message.empty())
+      c.message = fmt::format("the test program exited with code {}", run.exit_code);
+  }
+  if (run.timed_out || run.signal != 0 || !crash.empty()) {
+    c.message += fmt::format("\nto run this case alone (in a debugger, say): {} --test-case=\"{}\"",
+                             binary, c.name);
+  }
+}
+
+// --- Listing and running cases ----------------------------------------------------------------
+
+std::vector<Case> list_cases(const std::string& binary) {
+  const ProcessResult run = run_process({binary, "--list-test-cases", "--reporters=clothlab"}, 60);
+  std::vector<Fields> events;
+  std::string other;
+  parse_output(run.output, events, other);
+  if (run.timed_out || run.signal != 0 || run.exit_code != 0) {
+    fail(2, fmt::format("listing the cases of {} failed:\n{}", binary, run.output));
+  }
+  std::vector<Case> cases;
+  for (Fields& e : events) {
+    if (e[0] != "case") continue;
+    e.resize(6);
+    Case c;
+    c.suite = e[1];
+    c.name = e[2];
+    c.file = relative_path(e[3]);
+    c.line = std::atoi(e[4].c_str());
+    c.exercise = exercise_of(c.name, c.suite);
+    if (e[5].empty()) {
+      std::cerr << fmt::format(
+          "clothlab grade: warning: {}:{}: case \"{}\" has no POINTS(n): it counts 0 points\n",
+          c.file, c.line, c.name);
+    }
+    c.points = std::atoi(e[5].c_str());
+    cases.push_back(c);
+  }
+  if (cases.empty()) fail(2, binary + " lists no test cases (was it built with grade_main.cpp?)");
+  return cases;
+}
+
+void run_case(const std::string& binary, Case& c, double timeout) {
+  if (c.name.find(',') != std::string::npos) {
+    c.done = true;
+    c.status = "failed: the name contains a comma";
+    c.message = "doctest splits --test-case filters at commas: rename the case";
+    return;
+  }
+  // doctest matches names with wildcards it cannot escape; '?' still matches '*' or '?' itself,
+  // and judge() fails the case if that ever selects more than one case.
+  std::string filter;
+  for (char ch : c.name)
+    filter += (ch == '*' || ch == '?') ? std::string("?")
+              : ch == '\\'             ? std::string("\\\\")
+                                       : std::string(1, ch);
+  const auto start = Clock::now();
+  const ProcessResult run = run_process({binary, "--reporters=clothlab", "--test-case=" + filter,
+                                         "--case-sensitive=true", "--no-breaks=true"},
+                                        timeout);
+  c.seconds = std::chrono::duration<double>(Clock::now() - start).count();
+  judge(c, run, binary, timeout);
+}
+
+// --- Reports ------------------------------------------------------------------------------------
+
+struct Exercise {
+  std::string id;
+  std::vector<const Case*> cases;
+  int earned = 0, max = 0, passed = 0;
+};
+
+std::vector<Exercise> by_exercise(const std::vector<Case>& cases) {
+  std::vector<Exercise> exercises;
+  for (const Case& c : cases) {
+    auto it = std::find_if(exercises.begin(), exercises.end(),
+                           [&](const Exercise& x) { return x.id == c.exercise; });
+    if (it == exercises.end()) it = exercises.insert(exercises.end(), Exercise{c.exercise, {}});
+    it->cases.push_back(&c);
+    it->max += c.points;
+    if (c.passed) {
+      it->earned += c.points;
+      ++it->passed;
+    }
+  }
+  return exercises;
+}
+
+std::string paint(bool colour, fmt::text_style style, const std::string& text) {
+  return colour ? fmt::format(style, "{}", text) : text;
+}
+
+std::string indent(const std::string& text, const std::string& prefix) {
+  std::string out = prefix;
+  for (char ch : text)
+    out += ch == '\n' ? "\n" + prefix : std::string(1, ch);
+  return out;
+}
+
+std::string summary(const std::vector<Case>& cases, bool colour) {
+  const auto red = fmt::fg(fmt::terminal_color::red);
+  const auto green = fmt::fg(fmt::terminal_color::green);
+  const auto yellow = fmt::fg(fmt::terminal_color::yellow);
+  std::string s = fmt::format("{:<10} {:>9} {:>9}   {}\n", "Exercise", "Points", "Cases", "Status");
+  int earned = 0, max = 0;
+  for (const Exercise& x : by_exercise(cases)) {
+    earned += x.earned;
+    max += x.max;
+    const Case* first = nullptr;
+    bool all_not_started = true, all_run = true;
+    for (const Case* c : x.cases) {
+      if (!c->passed && first == nullptr) first = c;
+      all_not_started = all_not_started && c->not_started;
+      all_run = all_run && c->done;
+    }
+    std::string status;
+    if (first == nullptr)
+      status = paint(colour, green, "done");
+    else if (all_not_started)
+      status = paint(colour, yellow, "not started: " + lesson_hint(x.id));
+    else if (!all_run)
+      status = paint(colour, yellow, "not run");
+    else
+      status = paint(colour, red, "failing");
+    s += fmt::format("{:<10} {:>9} {:>9}   {}\n", x.id, fmt::format("{} / {}", x.earned, x.max),
+                     fmt::format("{} / {}", x.passed, x.cases.size()), status);
+    if (first != nullptr && !all_not_started && first->done) {
+      s += fmt::format("    {}: {}\n", paint(colour, fmt::emphasis::bold, first->name),
+                       paint(colour, red, first->status));
+      if (!first->message.empty()) s += indent(first->message, "      ") + "\n";
+      const std::string hint = lesson_hint(x.id);
+      if (!hint.empty()) s += "      " + hint + "\n";
+    }
+  }
+  s += "\n" +
+       paint(colour, fmt::emphasis::bold, fmt::format("Total: {} / {} points", earned, max)) + "\n";
+  return s;
+}
+
+// JSON and XML want valid UTF-8; a crashing case can print anything.
+std::string valid_utf8(const std::string& in) {
+  std::string out;
+  for (std::size_t i = 0; i < in.size();) {
+    const auto b = static_cast<unsigned char>(in[i]);
+    const std::size_t n = b < 0x80           ? 1
+                          : (b >> 5) == 0x6  ? 2
+                          : (b >> 4) == 0xE  ? 3
+                          : (b >> 3) == 0x1E ? 4
+                                             : 0;
+    bool ok = n > 0 && i + n <= in.size();
+    for (std::size_t k = 1; ok && k < n; ++k)
+      ok = (static_cast<unsigned char>(in[i + k]) >> 6) == 0x2;
+    out += ok ? in.substr(i, n) : "?";
+    i += ok ? n : 1;
+  }
+  return out;
+}
+
+std::string json_string(const std::string& text) {
+  std::string out = "\"";
+  for (char ch : valid_utf8(text)) {
+    if (ch == '"' || ch == '\\') {
+      out += {'\\', ch};
+    } else if (ch == '\n') {
+      out += "\\n";
+    } else if (static_cast<unsigned char>(ch) < 0x20) {
+      out += fmt::format("\\u{:04x}", static_cast<int>(ch));
+    } else {
+      out += ch;
+    }
+  }
+  return out + "\"";
+}
+
+std::string xml_escape(const std::string& text) {
+  std::string out;
+  for (char ch : valid_utf8(text)) {
+    if (ch == '&') {
+      out += "&amp;";
+    } else if (ch == '<') {
+      out += "&lt;";
+    } else if (ch == '>') {
+      out += "&gt;";
+    } else if (ch == '"') {
+      out += "&quot;";
+    } else if (static_cast<unsigned char>(ch) < 0x20 && ch != '\n' && ch != '\t') {
+      out += '?';  // XML 1.0 forbids other control characters, even escaped
+    } else {
+      out += ch;
+    }
+  }
+  return out;
+}
+
+// The text a report shows for one case: its status, first failure and own output.
+std::string case_report(const Case& c, bool with_output) {
+  std::string s = c.status + "\n";
+  if (!c.message.empty()) s += c.message + "\n";
+  if (!c.passed && !c.not_started) {
+    const std::string hint = lesson_hint(c.exercise);
+    if (!hint.empty()) s += hint + "\n";
+  }
+  if (with_output && !c.output.empty()) s += "\noutput:\n" + c.output.substr(0, 8000);
+  return s;
+}
+
+// Written to PATH.tmp then renamed, so a reader never sees half a file.
+void write_file(const std::string& path, const std::string& text) {
+  const std::string tmp = path + ".tmp";
+  {
+    std::ofstream out(tmp, std::ios::binary);
+    out << text;
+    if (!out.flush()) fail(2, "cannot write " + tmp);
+  }
+  std::error_code ec;
+  fs::rename(tmp, path, ec);
+  if (ec) fail(2, "cannot write " + path + ": " + ec.message());
+}
+
+std::string gradescope_json(const std::vector<Case>& cases, double seconds,
+                            const std::string& output) {
+  int score = 0;
+  std::string tests;
+  for (const Case& c : cases) {
+    score += c.passed ? c.points : 0;
+    tests += fmt::format(
+        "{}\n    {{\"name\": {}, \"number\": {}, \"score\": {}, \"max_score\": {}, "
+        "\"status\": \"{}\", \"output\": {}, \"visibility\": \"visible\"}}",
+        tests.empty() ? "" : ",", json_string(c.name), json_string(number_of(c.exercise)),
+        c.passed ? c.points : 0, c.points, c.passed ? "passed" : "failed",
+        json_string(case_report(c, true)));
+  }
+  return fmt::format(
+      "{{\n  \"score\": {},\n  \"execution_time\": {:.3f},\n  \"output\": {},\n  \"tests\": [{}\n  "
+      "]\n}}\n",
+      score, seconds, json_string(output), tests);
+}
+
+std::string junit_xml(const std::vector<Case>& cases, double seconds) {
+  std::string suites;
+  int failures = 0;
+  for (const Exercise& x : by_exercise(cases)) {
+    std::string body;
+    double time = 0;
+    for (const Case* c : x.cases) {
+      time += c->seconds;
+      body += fmt::format(
+          "    <testcase classname=\"{}\" name=\"{}\" file=\"{}\" line=\"{}\" time=\"{:.3f}\">\n",
+          xml_escape(x.id), xml_escape(c->name), xml_escape(c->file), c->line, c->seconds);
+      if (!c->passed) {
+        const std::string first_line =
+            c->status +
+            (c->message.empty() ? "" : ": " + c->message.substr(0, c->message.find('\n')));
+        body += fmt::format("      <failure message=\"{}\" type=\"{}\">{}</failure>\n",
+                            xml_escape(first_line),
+                            xml_escape(c->status.substr(0, c->status.find(':'))),
+                            xml_escape(case_report(*c, false)));
+      }
+      if (!c->output.empty())
+        body += fmt::format("      <system-out>{}</system-out>\n", xml_escape(c->output));
+      body += "    </testcase>\n";
+    }
+    const int failed = static_cast<int>(x.cases.size()) - x.passed;
+    failures += failed;
+    suites += fmt::format(
+        "  <testsuite name=\"{}\" tests=\"{}\" failures=\"{}\" errors=\"0\" time=\"{:.3f}\">\n{}  "
+        "</testsuite>\n",
+        xml_escape(x.id), x.cases.size(), failed, time, body);
+  }
+  return fmt::format(
+      "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n"
+      "<testsuites name=\"clothlab grade\" tests=\"{}\" failures=\"{}\" errors=\"0\" "
+      "time=\"{:.3f}\">\n{}</testsuites>\n",
+      cases.size(), failures, seconds, suites);
+}
+
+void write_reports(const Options& o, const std::vector<Case>& cases, double seconds) {
+  if (!o.results.empty())
+    write_file(o.results, gradescope_json(cases, seconds, summary(cases, false)));
+  if (!o.junit.empty()) write_file(o.junit, junit_xml(cases, seconds));
+}
+
+// --- The command --------------------------------------------------------------------------------
+
+std::string binary_for(const std::string& impl) {
+  // The grading binaries are built next to clothlab and clothlab-student.
+  std::error_code ec;
+  const fs::path self = fs::read_symlink("/proc/self/exe", ec);
+  const fs::path path = (ec ? fs::current_path() : self.parent_path()) / ("grade-" + impl);
+  if (!fs::exists(path)) {
+    fail(2, fmt::format(
+                "{} does not exist: build it first with\n  cmake --build build --target grade-{}",
+                path.string(), impl));
+  }
+  return path.string();
+}
+
+bool selected(const Case& c, const std::string& filter) {
+  return filter.empty() || c.exercise == filter || c.exercise.starts_with(filter + ".");
+}
+
+void print_points_table(const std::vector<Case>& cases) {
+  std::size_t width = 4;
+  for (const Case& c : cases)
+    width = std::max(width, c.name.size());
+  fmt::print("{:<10} {:<{}} {:>6}\n", "Exercise", "Case", width, "Points");
+  int total = 0;
+  for (const Case& c : cases) {
+    fmt::print("{:<10} {:<{}} {:>6}\n", c.exercise, c.name, width, c.points);
+    total += c.points;
+  }
+  fmt::print("\nTotal: {} points in {} cases\n", total, cases.size());
+}
+
+void grade(const Options& o) {
+  const std::string binary = o.binary.empty() ? binary_for(o.impl) : o.binary;
+  if (!fs::exists(binary)) fail(2, binary + " does not exist");
+  std::vector<Case> cases = list_cases(binary);
+  if (!o.exercise.empty()) {
+    std::erase_if(cases, [&](const Case& c) { return !selected(c, o.exercise); });
+    if (cases.empty()) fail(2, "no grading case belongs to exercise " + o.exercise);
+  }
+  if (o.list) {
+    print_points_table(cases);
+    return;
+  }
+
+  const bool terminal = isatty(STDOUT_FILENO) != 0;
+  const char* no_color = std::getenv("NO_COLOR");
+  const bool colour = terminal && (no_color == nullptr || *no_color == '\0');
+
+  g_interrupted = 0;
+  InterruptGuard guard;
+  const auto start = Clock::now();
+  auto elapsed = [&] { return std::chrono::duration<double>(Clock::now() - start).count(); };
+  for (std::size_t i = 0; i < cases.size() && !g_interrupted; ++i) {
+    if (colour) fmt::print("\r\033[K[{}/{}] {}", i + 1, cases.size(), cases[i].name.substr(0, 70));
+    std::fflush(stdout);
+    run_case(binary, cases[i], o.timeout);
+    write_reports(o, cases, elapsed());  // after every case, so an interrupted run leaves results
+  }
+  if (colour) fmt::print("\r\033[K");
+  std::fflush(stdout);
+
+  fmt::print("{}", summary(cases, colour));
+  write_reports(o, cases, elapsed());
+  if (g_interrupted) fail(130, "interrupted: the results of the cases run so far are written");
+
+  if (o.require_full) {
+    const auto failed =
+        std::count_if(cases.begin(), cases.end(), [](const Case& c) { return !c.passed; });
+    if (failed > 0)
+      fail(1, fmt::format("--require-full: {} of {} cases did not pass", failed, cases.size()));
+  }
+  if (o.require_zero) {
+    std::string scored;
+    for (const Exercise& x : by_exercise(cases)) {
+      if (x.earned > 0)
+        scored += fmt::format("\n  {} scores {} / {} points", x.id, x.earned, x.max);
+    }
+    if (!scored.empty()) {
+      fail(1, "--require-zero: these exercises score points, so their tests cannot fail:" + scored);
+    }
+  }
+}
+
+}  // namespace
+
+void add_grade_command(CLI::App& app) {
+  auto o = std::make_shared<Options>();
+  CLI::App* cmd = app.add_subcommand("grade", "Run the grading tests and score each exercise");
+  cmd->add_option("--impl", o->impl,
+                  "Which kernels to grade: your exercises, the reference or the shipped stubs")
+      ->check(CLI::IsMember({"student", "reference", "stubs"}))
+      ->capture_default_str();
+  cmd->add_option("--exercise", o->exercise, "Grade one lesson (ex01) or one exercise (ex01.2)")
+      ->check(CLI::Validator(
+          [](std::string& s) {
+            return is_exercise_id(s, true) ? std::string() : "expected exNN or exNN.k";
+          },
+          "exNN[.k]"));
+  cmd->add_flag("--list", o->list, "Print the points table without running anything");
+  cmd->add_option("--timeout", o->timeout, "Seconds a case may run before it is stopped")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
+  cmd->add_option("--results", o->results, "Write Gradescope results.json here");
+  cmd->add_option("--junit", o->junit, "Write JUnit XML here");
+  cmd->add_flag("--require-full", o->require_full, "Exit with status 1 unless every case passed");
+  cmd->add_flag("--require-zero", o->require_zero,
+                "Exit with status 1 unless every exercise scored zero");
+  cmd->add_option("--binary", o->binary, "Grade this doctest binary (built with grade_main.cpp)")
+      ->group("");
+  cmd->callback([o] { grade(*o); });
+}
+
+}  // namespace clothlab::app

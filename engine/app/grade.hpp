@@ -1,0 +1,20 @@
+// grade.hpp: the `clothlab grade` subcommand.
+//
+// The grader runs the grading tests (tests/grade/NN_*.cpp, built into grade-student,
+// grade-reference and grade-stubs next to this program) one case per process, so that a crash or
+// an endless loop costs that case only, and reports points per exercise with hints that point to
+// the lesson. It also writes Gradescope results.json and JUnit XML.
+#pragma once
+
+namespace CLI {
+class App;
+}
+
+namespace clothlab::app {
+
+// Adds the `grade` subcommand to app. On failure its callback throws CLI::RuntimeError with the
+// exit status (1: --require-full or --require-zero not met, 2: the grader could not run,
+// 130: interrupted), which CLI11_PARSE / app.exit() turn into main's return value.
+void add_grade_command(CLI::App& app);
+
+}  // namespace clothlab::app

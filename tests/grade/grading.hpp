@@ -1,0 +1,44 @@
+// grading.hpp: what every grading file includes.
+//
+// A grading test case belongs to one exercise and carries points:
+//
+//   TEST_SUITE("ex01") {
+//   TEST_CASE("ex01.1 gravity pulls down with m g" * POINTS(2)) { ... }
+//   }
+//
+// The case name starts with the exercise ID; POINTS(n) is how many points it is worth. Case
+// names must not contain commas, '*' or '?' (doctest reads those as filter syntax).
+// Expectations are derived in a comment beside each check, and a grading test never calls
+// the solutions: it must hold for any correct answer.
+#pragma once
+
+#include <doctest/doctest.h>
+
+#include <sstream>
+#include <string>
+
+#include "clothlab/types.hpp"
+
+#define POINTS(n) doctest::description("points=" #n)
+
+namespace doctest {
+// Prints a Vec3 as (x, y, z) in a failed check, so the message shows the numbers.
+template <>
+struct StringMaker<clothlab::Vec3> {
+  static String convert(const clothlab::Vec3& a) {
+    std::ostringstream out;
+    out.precision(10);
+    out << "(" << a.x() << ", " << a.y() << ", " << a.z() << ")";
+    return out.str().c_str();
+  }
+};
+}  // namespace doctest
+
+namespace grading {
+
+// True when |a - b| <= tol in every component; use with CHECK_MESSAGE to say what was expected.
+inline bool near(const clothlab::Vec3& a, const clothlab::Vec3& b, double tol) {
+  return ((a - b).cwiseAbs().array() <= tol).all();
+}
+
+}  // namespace grading
