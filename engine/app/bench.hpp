@@ -1,0 +1,8 @@
+// bench.hpp: `clothlab bench`, measurements that print figures and ratios from one run.
+#pragma once
+
+#include <CLI/CLI.hpp>
+
+namespace clothlab::app {
+void add_bench_command(CLI::App& app);
+}  // namespace clothlab::app

@@ -1,0 +1,22 @@
+# A bad scene: exit code 2, the FILE:LINE:COL message on stderr, and the output folder of an
+# earlier run left exactly as it was.
+file(REMOVE_RECURSE ${WORK})
+file(MAKE_DIRECTORY ${WORK}/out)
+file(WRITE ${WORK}/out/energy.csv "an earlier run's results\n")
+execute_process(COMMAND ${CLOTHLAB} run ${SCENES}/bad/zero_mass.toml --out ${WORK}/out
+                RESULT_VARIABLE code ERROR_VARIABLE err OUTPUT_VARIABLE out)
+if(NOT code EQUAL 2)
+  message(FATAL_ERROR "expected exit code 2, got ${code}\n${out}${err}")
+endif()
+if(NOT err MATCHES "zero_mass.toml:4:8: 'mass' in \\[\\[particle\\]\\] #1 is 0; expected a number > 0 \\[kg\\]")
+  message(FATAL_ERROR "unexpected message:\n${err}")
+endif()
+file(READ ${WORK}/out/energy.csv kept)
+if(NOT kept STREQUAL "an earlier run's results\n")
+  message(FATAL_ERROR "the earlier output was overwritten")
+endif()
+file(GLOB left ${WORK}/out/*)
+list(LENGTH left count)
+if(NOT count EQUAL 1)
+  message(FATAL_ERROR "a bad scene wrote files: ${left}")
+endif()

@@ -1,0 +1,105 @@
+// Bad scenes: one file per mistake under tests/scenes/bad/, each starting with the line
+//   # expect: LINE:COL: message
+// The test loads the file and checks the error is exactly FILE:LINE:COL: message.
+#include <doctest/doctest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+#include "clothlab/scene.hpp"
+
+namespace fs = std::filesystem;
+
+namespace {
+
+std::string expected_error(const fs::path& file) {
+  std::ifstream in(file);
+  std::string first;
+  std::getline(in, first);
+  const std::string marker = "# expect: ";
+  REQUIRE_MESSAGE(first.rfind(marker, 0) == 0, file.string() << " must start with '# expect: '");
+  return file.string() + ":" + first.substr(marker.size());
+}
+
+void check_bad_scene(const std::string& name) {
+  const fs::path file = fs::path(CLOTHLAB_TEST_SCENES) / "bad" / name;
+  REQUIRE(fs::exists(file));
+  const std::string expected = expected_error(file);
+  try {
+    (void)clothlab::load_scene_file(file);
+    FAIL("the scene loaded, but it should have been rejected with: " << expected);
+  } catch (const clothlab::SceneError& e) {
+    CHECK(std::string(e.what()) == expected);
+  }
+}
+
+}  // namespace
+
+// One test case per message, so a report names the message that changed.
+TEST_CASE("scene error: TOML syntax error") {
+  check_bad_scene("syntax_error.toml");
+}
+TEST_CASE("scene error: unknown table") {
+  check_bad_scene("unknown_table.toml");
+}
+TEST_CASE("scene error: unknown key") {
+  check_bad_scene("unknown_key.toml");
+}
+TEST_CASE("scene error: wrong type") {
+  check_bad_scene("wrong_type.toml");
+}
+TEST_CASE("scene error: missing required key") {
+  check_bad_scene("missing_mass.toml");
+}
+TEST_CASE("scene error: zero mass") {
+  check_bad_scene("zero_mass.toml");
+}
+TEST_CASE("scene error: negative dt") {
+  check_bad_scene("negative_dt.toml");
+}
+TEST_CASE("scene error: zero dt") {
+  check_bad_scene("zero_dt.toml");
+}
+TEST_CASE("scene error: NaN in a vector") {
+  check_bad_scene("nan_velocity.toml");
+}
+TEST_CASE("scene error: infinite number") {
+  check_bad_scene("infinite_g.toml");
+}
+TEST_CASE("scene error: unknown integrator") {
+  check_bad_scene("unknown_integrator.toml");
+}
+TEST_CASE("scene error: no integrator table") {
+  check_bad_scene("no_integrator.toml");
+}
+TEST_CASE("scene error: no particles") {
+  check_bad_scene("no_particles.toml");
+}
+TEST_CASE("scene error: a vector of two numbers") {
+  check_bad_scene("short_vector.toml");
+}
+TEST_CASE("scene error: [particle] instead of [[particle]]") {
+  check_bad_scene("particle_not_array.toml");
+}
+TEST_CASE("scene error: dt longer than the duration") {
+  check_bad_scene("dt_longer_than_duration.toml");
+}
+TEST_CASE("scene error: negative gravitational constant") {
+  check_bad_scene("negative_G.toml");
+}
+
+TEST_CASE("scene error: every bad scene file has a test case") {
+  // A file added to tests/scenes/bad/ without a test above would never be checked.
+  int files = 0;
+  for (const auto& entry : fs::directory_iterator(fs::path(CLOTHLAB_TEST_SCENES) / "bad")) {
+    if (entry.path().extension() == ".toml") ++files;
+  }
+  CHECK(files == 17);
+}
+
+TEST_CASE("scene error: a missing file") {
+  CHECK_THROWS_WITH_AS((void)clothlab::load_scene_file("no/such/scene.toml"),
+                       "no/such/scene.toml:1:1: cannot open the file; expected a readable scene",
+                       clothlab::SceneError);
+}
