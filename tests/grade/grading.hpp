@@ -36,9 +36,20 @@ struct StringMaker<clothlab::Vec3> {
 
 namespace grading {
 
-// True when |a - b| <= tol in every component; use with CHECK_MESSAGE to say what was expected.
+// True when |a - b| <= tol in every component (and both are finite).
 inline bool near(const clothlab::Vec3& a, const clothlab::Vec3& b, double tol) {
   return ((a - b).cwiseAbs().array() <= tol).all();
 }
 
+// "(x, y, z)" with enough digits to tell two answers apart.
+inline std::string show(const clothlab::Vec3& a) {
+  return doctest::StringMaker<clothlab::Vec3>::convert(a).c_str();
+}
+
 }  // namespace grading
+
+// Checks that two Vec3 agree within tol, and on failure prints both: "got (..), expected (..)".
+#define CHECK_NEAR_VEC(actual, expected, tol)                                                   \
+  CHECK_MESSAGE(::grading::near((actual), (expected), (tol)),                                   \
+                "got " << ::grading::show(actual) << ", expected " << ::grading::show(expected) \
+                       << " (to within " << (tol) << ")")
