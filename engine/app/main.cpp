@@ -86,6 +86,7 @@ int run(Scene& scene, const fs::path& out_dir) {
     fmt::print("\n");
     return 0;
   } catch (const SimulationError& error) {
+    std::fflush(stdout);  // what was said before the error comes before it
     if (bar.shown()) fmt::print(stderr, "\n");
     fmt::print(stderr, "error: {}\n", error.what());
     fmt::print(stderr, "  frames up to step {} are in {}/\n", error.step() - 1, out_dir.string());
@@ -140,9 +141,11 @@ int main(int argc, char** argv) {
       return run(scene, fs::path("clothlab-out") / "demo");
     }
   } catch (const SceneError& error) {
+    std::fflush(stdout);
     fmt::print(stderr, "error: {}\n", error.what());
     return kBadScene;
   } catch (const NotImplemented& error) {
+    std::fflush(stdout);
     fmt::print(stderr, "error: {}\n", error.what());
     return kNotDone;
   } catch (const std::exception& error) {

@@ -48,9 +48,9 @@ void Guard::check(const World& world) const {
   // place); a value that grows past any bound is energy that the integrator keeps adding.
   const char* advice =
       value.allFinite()
-          ? "a time step too large for the stiffness is the usual cause: try a smaller dt or "
+          ? "A time step too large for the stiffness is the usual cause: try a smaller dt or "
             "another integrator"
-          : "a NaN usually comes from a division by zero (a zero length, two particles at the "
+          : "A NaN usually comes from a division by zero (a zero length, two particles at the "
             "same place) or from values that overflowed after growing without bound";
   throw SimulationError(
       fmt::format("simulation blew up at step {} (t = {:.6g} s): particle {} {}. Effects in play: "

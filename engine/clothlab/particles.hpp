@@ -21,8 +21,11 @@ struct Particles {
   Index size() const { return x.cols(); }
 
   // Appends one particle and returns its index. mass [kg] must be positive and finite.
-  // (Each call reallocates; builders of large grids size the arrays once instead.)
   Index add(const Vec3& position, const Vec3& velocity, double mass);
+
+  // Appends n particles of the given mass [kg] at the origin, at rest, and returns the index of
+  // the first. Builders of large grids use this: the arrays grow once, not once per particle.
+  Index grow(Index n, double mass);
 };
 
 }  // namespace clothlab

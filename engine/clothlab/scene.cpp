@@ -183,6 +183,75 @@ Vec3 SceneTable::required_vec3(std::string_view key, std::string_view unit) {
   return vec3(key, unit, Vec3::Zero());
 }
 
+namespace {
+
+long checked_integer(const toml::node& node, const std::string& source, std::string_view what,
+                     long min, long max) {
+  const auto* i = node.as_integer();
+  if (!i) {
+    fail_at(source, node.source(),
+            fmt::format("{} is {}; expected a whole number from {} to {}", what, type_name(node),
+                        min, max));
+  }
+  const long value = static_cast<long>(i->get());
+  if (value < min || value > max) {
+    fail_at(source, node.source(),
+            fmt::format("{} is {}; expected a whole number from {} to {}", what, value, min, max));
+  }
+  return value;
+}
+
+}  // namespace
+
+long SceneTable::integer(std::string_view key, long min, long max, long fallback) {
+  const toml::node* node = as_table(node_).get(key);
+  if (!node) return fallback;
+  return checked_integer(*node, source_, fmt::format("'{}' in {}", key, name_), min, max);
+}
+
+long SceneTable::required_integer(std::string_view key, long min, long max) {
+  if (!has(key)) {
+    fail(key, fmt::format("{} has no '{}'; expected {} = a whole number from {} to {}", name_, key,
+                          key, min, max));
+  }
+  return integer(key, min, max, 0);
+}
+
+std::vector<long> SceneTable::integer_list(std::string_view key, long min, long max,
+                                           std::string_view what) {
+  std::vector<long> values;
+  const toml::node* node = as_table(node_).get(key);
+  if (!node) return values;
+  const toml::array* array = node->as_array();
+  if (!array) {
+    fail_at(source_, node->source(),
+            fmt::format("'{}' in {} is {}; expected an array of {}s", key, name_, type_name(*node),
+                        what));
+  }
+  for (size_t k = 0; k < array->size(); ++k) {
+    values.push_back(checked_integer(
+        (*array)[k], source_, fmt::format("{} '{}[{}]' in {}", what, key, k, name_), min, max));
+  }
+  return values;
+}
+
+bool SceneTable::boolean(std::string_view key, bool fallback) {
+  const toml::node* node = as_table(node_).get(key);
+  if (!node) return fallback;
+  if (const auto* b = node->as_boolean()) return b->get();
+  fail_at(source_, node->source(),
+          fmt::format("'{}' in {} is {}; expected true or false", key, name_, type_name(*node)));
+}
+
+bool SceneTable::has(std::string_view key) const {
+  return as_table(node_).contains(key);
+}
+
+bool SceneTable::is_string(std::string_view key) const {
+  const toml::node* node = as_table(node_).get(key);
+  return node && node->is_string();
+}
+
 std::optional<std::string> SceneTable::string(std::string_view key) {
   const toml::node* node = as_table(node_).get(key);
   if (!node) return std::nullopt;
@@ -311,7 +380,7 @@ Scene parse_scene(std::string_view text, const std::string& source) {
       kind.read(table, scene);
     }
   }
-  check_scene(scene, [&](const std::string& message) { fail_at(source, top, message); });
+  finish_scene(scene, [&](const std::string& message) { fail_at(source, top, message); });
   return scene;
 }
 

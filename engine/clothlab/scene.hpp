@@ -8,10 +8,14 @@
 #pragma once
 
 #include <filesystem>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <string_view>
 
+#include "clothlab/cloth.hpp"
+#include "clothlab/rope.hpp"
+#include "clothlab/spring_damper.hpp"
 #include "clothlab/world.hpp"
 
 namespace clothlab {
@@ -42,6 +46,11 @@ struct Scene {
   double dt = 0.0;        // time step [s]
   double duration = 0.0;  // simulated time [s]
   OutputSettings output;
+
+  // What the builders made, for the tables read after them (springs, bending, aerodynamics).
+  std::optional<ClothGrid> cloth;
+  std::optional<Rope> rope;
+  SpringSet springs;  // structural, shear and one-by-one springs: the "springs" effect
 
   long step_count() const;  // steps needed to cover `duration`
 };

@@ -39,7 +39,15 @@ class SceneTable {
   double required_number(std::string_view key, const Range& range);
   Vec3 vec3(std::string_view key, std::string_view unit, const Vec3& fallback);
   Vec3 required_vec3(std::string_view key, std::string_view unit);
+  // Whole numbers from min to max (inclusive).
+  long integer(std::string_view key, long min, long max, long fallback);
+  long required_integer(std::string_view key, long min, long max);
+  // An array of whole numbers, each from min to max; `what` names one element in messages.
+  std::vector<long> integer_list(std::string_view key, long min, long max, std::string_view what);
+  bool boolean(std::string_view key, bool fallback);
   std::optional<std::string> string(std::string_view key);
+  bool has(std::string_view key) const;
+  bool is_string(std::string_view key) const;
   // A string that must be one of `choices`.
   std::string choice(std::string_view key, const std::vector<std::string_view>& choices,
                      std::string_view fallback);

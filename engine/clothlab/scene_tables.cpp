@@ -5,6 +5,8 @@
 
 #include <fmt/format.h>
 
+#include "clothlab/aerodynamics.hpp"
+#include "clothlab/bending.hpp"
 #include "clothlab/gravitation.hpp"
 #include "clothlab/gravity.hpp"
 
@@ -17,7 +19,172 @@ void read_particle(SceneTable& t, Scene& scene) {
   const Vec3 x = t.required_vec3("position", "m");
   const Vec3 v = t.vec3("velocity", "m/s", Vec3::Zero());
   const double m = t.required_number("mass", Range::positive("kg"));
-  scene.world.particles.add(x, v, m);
+  const Index i = scene.world.particles.add(x, v, m);
+  if (t.boolean("pinned", false)) pin(scene.world.particles, i);
+}
+
+// Pins of a builder: a name (e.g. "top-corners") or an array of local indices below `count`.
+std::vector<Index> read_pins(
+    SceneTable& t, Index count,
+    const std::function<bool(std::string_view, std::vector<Index>&)>& named,
+    std::string_view names) {
+  std::vector<Index> pins;
+  if (t.is_string("pins")) {
+    const std::string name = *t.string("pins");
+    if (!named(name, pins)) {
+      t.fail("pins", fmt::format("unknown pin set '{}' in {}; expected one of: {}, or an array "
+                                 "of particle indices",
+                                 name, t.display_name(), names));
+    }
+  } else {
+    for (long i : t.integer_list("pins", 0, static_cast<long>(count) - 1, "pin index")) {
+      pins.push_back(i);
+    }
+  }
+  return pins;
+}
+
+// Total mass from `mass` [kg] or from `density` [kg/m^2] times `area` [m^2]: exactly one of the
+// two keys.
+double read_mass_or_density(SceneTable& t, double area) {
+  if (t.has("mass") && t.has("density")) {
+    t.fail("density", fmt::format("{} gives both mass and density; expected one of the two",
+                                  t.display_name()));
+  }
+  if (t.has("density")) return t.number("density", Range::positive("kg/m^2"), 0.0) * area;
+  return t.required_number("mass", Range::positive("kg"));
+}
+
+// [rope]: a chain of particles from start to end (lesson 02).
+void read_rope(SceneTable& t, Scene& scene) {
+  RopeSpec spec;
+  spec.start = t.required_vec3("start", "m");
+  spec.end = t.required_vec3("end", "m");
+  spec.particles = t.required_integer("particles", 2, 1000000);
+  spec.mass = t.required_number("mass", Range::positive("kg"));
+  if (spec.start == spec.end) {
+    t.fail("end", "the rope's start and end are the same point; expected a rope of some length");
+  }
+  Particles& p = scene.world.particles;
+  const Rope rope = add_rope(p, spec);
+  const auto named = [&](std::string_view name, std::vector<Index>& out) {
+    if (name == "first" || name == "both") out.push_back(0);
+    if (name == "last" || name == "both") out.push_back(rope.count - 1);
+    return name == "first" || name == "last" || name == "both" || name == "none";
+  };
+  for (Index i : read_pins(t, rope.count, named, "first, last, both, none"))
+    pin(p, rope.first + i);
+  scene.rope = rope;
+}
+
+// [cloth]: a rectangular grid of particles (lesson 02).
+void read_cloth(SceneTable& t, Scene& scene) {
+  ClothSpec spec;
+  spec.rows = t.required_integer("rows", 2, 4096);
+  spec.cols = t.required_integer("cols", 2, 4096);
+  spec.spacing = t.required_number("spacing", Range::positive("m"));
+  spec.origin = t.vec3("origin", "m", Vec3::Zero());
+  spec.horizontal = t.choice("plane", {"vertical", "horizontal"}, "vertical") == "horizontal";
+  const double area = static_cast<double>(spec.rows - 1) * static_cast<double>(spec.cols - 1) *
+                      spec.spacing * spec.spacing;
+  spec.mass = read_mass_or_density(t, area);
+  Particles& p = scene.world.particles;
+  const ClothGrid grid = add_cloth(p, spec);
+  const auto named = [&](std::string_view name, std::vector<Index>& out) {
+    return named_pins(grid, name, out);
+  };
+  for (Index i :
+       read_pins(t, grid.size(), named, "top-corners, corners, top-edge, left-edge, none")) {
+    pin(p, grid.first + i);
+  }
+  scene.cloth = grid;
+  scene.world.triangles = grid_triangles(grid);
+}
+
+// [[spring]]: one spring-damper between two particles given by index (lesson 02).
+void read_spring(SceneTable& t, Scene& scene) {
+  const Particles& p = scene.world.particles;
+  if (p.size() < 2)
+    t.fail("i", "a [[spring]] needs two particles; expected [[particle]] tables first");
+  const long last = static_cast<long>(p.size()) - 1;
+  const Index i = t.required_integer("i", 0, last);
+  const Index j = t.required_integer("j", 0, last);
+  if (i == j)
+    t.fail("j", fmt::format("the spring joins particle {} to itself; expected i != j", i));
+  const double ks = t.required_number("ks", Range::non_negative("N/m"));
+  const double kd = t.number("kd", Range::non_negative("N s/m"), 0.0);
+  const double l0 = t.number("l0", Range::non_negative("m"), -1.0);  // default: distance now
+  scene.springs.add(i, j, ks, kd, l0, p.x);
+}
+
+// [springs]: structural and shear springs of the cloth, or the rope's springs (lesson 02).
+void read_springs(SceneTable& t, Scene& scene) {
+  if (!scene.cloth && !scene.rope) {
+    t.fail("ks",
+           "[springs] has nothing to connect; expected a [cloth] or a [rope] (springs "
+           "between single particles are [[spring]] tables)");
+  }
+  const double ks = t.required_number("ks", Range::non_negative("N/m"));
+  const double kd = t.number("kd", Range::non_negative("N s/m"), 0.0);
+  const double shear_ks = t.number("shear_ks", Range::non_negative("N/m"), ks);
+  const double shear_kd = t.number("shear_kd", Range::non_negative("N s/m"), kd);
+  const Matrix3X& x = scene.world.particles.x;
+  if (scene.rope)
+    add_spring_family(scene.springs, rope_pairs(scene.rope->count), scene.rope->first, ks, kd, x);
+  if (scene.cloth) {
+    const ClothGrid& g = *scene.cloth;
+    add_spring_family(scene.springs, structural_pairs(g.rows, g.cols), g.first, ks, kd, x);
+    add_spring_family(scene.springs, shear_pairs(g.rows, g.cols), g.first, shear_ks, shear_kd, x);
+  }
+}
+
+// [bending]: flexion springs two apart, with their own constants (lesson 04).
+void read_bending(SceneTable& t, Scene& scene) {
+  if (!scene.cloth && !scene.rope) {
+    t.fail("ks", "[bending] has nothing to bend; expected a [cloth] or a [rope]");
+  }
+  const double ks = t.required_number("ks", Range::non_negative("N/m"));
+  const double kd = t.number("kd", Range::non_negative("N s/m"), 0.0);
+  const Matrix3X& x = scene.world.particles.x;
+  SpringSet bending;
+  if (scene.rope)
+    add_spring_family(bending, rope_bending_pairs(scene.rope->count), scene.rope->first, ks, kd, x);
+  if (scene.cloth) {
+    const ClothGrid& g = *scene.cloth;
+    add_spring_family(bending, bending_pairs(g.rows, g.cols), g.first, ks, kd, x);
+  }
+  scene.world.force_effects.push_back(
+      std::make_unique<SpringDampers>("bending", std::move(bending)));
+}
+
+// [aerodynamics]: air on the cloth's triangles (lesson 03).
+void read_aerodynamics(SceneTable& t, Scene& scene) {
+  if (!scene.cloth) {
+    t.fail("rho", "[aerodynamics] acts on a cloth's triangles; expected a [cloth] table");
+  }
+  const double rho = t.number("rho", Range::non_negative("kg/m^3"), kAirDensity);
+  const double cd = t.number("cd", Range::non_negative(""), 1.0);
+  const Vec3 wind = t.vec3("wind", "m/s", Vec3::Zero());
+  scene.world.force_effects.push_back(
+      std::make_unique<Aerodynamics>(scene.world.triangles, rho, cd, wind));
+}
+
+// [drag]: fluid drag on every particle (lesson 03).
+void read_drag(SceneTable& t, Scene& scene) {
+  const double rho = t.number("rho", Range::non_negative("kg/m^3"), kAirDensity);
+  const double cd = t.number("cd", Range::non_negative(""), 0.47);  // a sphere's
+  const double area = t.required_number("area", Range::positive("m^2"));
+  const Vec3 wind = t.vec3("wind", "m/s", Vec3::Zero());
+  scene.world.force_effects.push_back(std::make_unique<FluidDrag>(rho, cd, area, wind));
+}
+
+// [buoyancy]: a fluid below y = surface lifts the particles in it (lesson 03).
+void read_buoyancy(SceneTable& t, Scene& scene) {
+  const double rho = t.number("rho", Range::positive("kg/m^3"), 1000.0);  // water
+  const double volume = t.required_number("volume", Range::positive("m^3"));
+  const double surface = t.number("surface", Range::any("m"), 0.0);
+  const double g = t.number("g", Range::positive("m/s^2"), 9.8);
+  scene.world.force_effects.push_back(std::make_unique<Buoyancy>(rho, volume, surface, g));
 }
 
 // [gravity]: uniform gravity, f = m g (lesson 01).
@@ -58,10 +225,24 @@ void read_guard(SceneTable& t, Scene& scene) {
 
 // The order here is the order of reading: whatever creates particles comes first.
 constexpr std::array kKinds = {
-    SceneTableKind{"particle", true, false, "position velocity mass",
+    SceneTableKind{"particle", true, false, "position velocity mass pinned",
                    "[[particle]] with position, velocity and mass", read_particle},
+    SceneTableKind{"rope", false, false, "start end particles mass pins",
+                   "[rope] with start, end, particles and mass", read_rope},
+    SceneTableKind{"cloth", false, false, "rows cols spacing origin plane mass density pins",
+                   "[cloth] with rows, cols, spacing and mass", read_cloth},
+    SceneTableKind{"spring", true, false, "i j ks kd l0", "[[spring]] with i, j and ks",
+                   read_spring},
+    SceneTableKind{"springs", false, false, "ks kd shear_ks shear_kd", "[springs] with ks",
+                   read_springs},
+    SceneTableKind{"bending", false, false, "ks kd", "[bending] with ks", read_bending},
     SceneTableKind{"gravity", false, false, "g", "[gravity] with g", read_gravity},
     SceneTableKind{"gravitation", false, false, "G", "[gravitation] with G", read_gravitation},
+    SceneTableKind{"aerodynamics", false, false, "rho cd wind",
+                   "[aerodynamics] with rho, cd and wind", read_aerodynamics},
+    SceneTableKind{"drag", false, false, "rho cd area wind", "[drag] with area", read_drag},
+    SceneTableKind{"buoyancy", false, false, "rho volume surface g", "[buoyancy] with volume",
+                   read_buoyancy},
     SceneTableKind{"integrator", false, true, "method dt duration",
                    "[integrator] with method, dt [s] and duration [s]", read_integrator},
     SceneTableKind{"output", false, false, "fps", "[output] with fps", read_output},
@@ -89,9 +270,15 @@ std::string scene_table_names() {
   return names;
 }
 
-void check_scene(const Scene& scene, const std::function<void(const std::string&)>& fail) {
+void finish_scene(Scene& scene, const std::function<void(const std::string&)>& fail) {
   if (scene.world.particles.size() == 0) {
-    fail("the scene has no particles; expected at least one [[particle]] table");
+    fail("the scene has no particles; expected [[particle]] tables, a [rope] or a [cloth]");
+  }
+  // Structural, shear and one-by-one springs make one effect, built once all are known.
+  if (scene.springs.size() > 0) {
+    scene.world.force_effects.push_back(
+        std::make_unique<SpringDampers>("springs", std::move(scene.springs)));
+    scene.springs = SpringSet{};
   }
 }
 

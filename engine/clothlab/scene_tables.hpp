@@ -25,7 +25,8 @@ std::span<const SceneTableKind> scene_table_kinds();
 const SceneTableKind* find_scene_table(std::string_view name);
 std::string scene_table_names();  // "title particle gravity ...": every top-level name
 
-// Checks that need the whole scene (e.g. "at least one particle"); calls fail(message).
-void check_scene(const Scene& scene, const std::function<void(const std::string&)>& fail);
+// After every table is read: checks that need the whole scene ("at least one particle"),
+// calling fail(message), and builds what several tables feed (the "springs" effect).
+void finish_scene(Scene& scene, const std::function<void(const std::string&)>& fail);
 
 }  // namespace clothlab

@@ -16,12 +16,14 @@
 #include "clothlab/guard.hpp"
 #include "clothlab/integrator.hpp"
 #include "clothlab/particles.hpp"
+#include "clothlab/triangles.hpp"
 
 namespace clothlab {
 
 class World {
  public:
   Particles particles;
+  std::vector<Triangle> triangles;  // the cloth's surface (lesson 03), for effects and output
   std::vector<std::unique_ptr<ForceEffect>> force_effects;
   std::vector<std::unique_ptr<PostStepEffect>> post_step_effects;
   std::unique_ptr<Integrator> integrator;

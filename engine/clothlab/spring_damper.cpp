@@ -1,0 +1,40 @@
+#include "clothlab/spring_damper.hpp"
+
+namespace clothlab {
+
+void SpringSet::add(Index a, Index b, double ks_ab, double kd_ab, double l0_ab, const Matrix3X& x) {
+  i.push_back(a);
+  j.push_back(b);
+  ks.push_back(ks_ab);
+  kd.push_back(kd_ab);
+  l0.push_back(l0_ab >= 0.0 ? l0_ab : (x.col(b) - x.col(a)).norm());
+}
+
+void add_spring_family(SpringSet& springs, const std::vector<std::pair<Index, Index>>& pairs,
+                       Index first, double ks, double kd, const Matrix3X& x) {
+  for (const auto& [a, b] : pairs)
+    springs.add(first + a, first + b, ks, kd, -1.0, x);
+}
+
+void SpringDampers::add_forces(const Particles& /*p*/, const Matrix3X& x, const Matrix3X& v,
+                               Matrix3X& f) const {
+  const SpringSet& s = springs_;
+  for (size_t k = 0; k < s.size(); ++k) {
+    const Index a = s.i[k], b = s.j[k];
+    const Vec3 f1 =
+        spring_damper_force(x.col(a), x.col(b), v.col(a), v.col(b), s.ks[k], s.kd[k], s.l0[k]);
+    f.col(a) += f1;  // f2 = -f1: what pulls one end pushes the other
+    f.col(b) -= f1;
+  }
+}
+
+double SpringDampers::potential_energy(const Particles& /*p*/, const Matrix3X& x) const {
+  const SpringSet& s = springs_;
+  double energy = 0.0;
+  for (size_t k = 0; k < s.size(); ++k) {
+    energy += spring_energy(x.col(s.i[k]), x.col(s.j[k]), s.ks[k], s.l0[k]);
+  }
+  return energy;
+}
+
+}  // namespace clothlab

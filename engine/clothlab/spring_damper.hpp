@@ -1,0 +1,69 @@
+// spring_damper.hpp: spring-damper elements between pairs of particles.
+//
+// Lecture: a spring-damper joins particles 1 and 2 with a spring constant ks [N/m], a damping
+// factor kd [N s/m] and a rest length l0 [m]. It works along the line between the particles:
+//
+//   e* = r2 - r1,   l = |e*|,   e = e* / l          (unit vector from 1 toward 2)
+//   v1 = e . v1,    v2 = e . v2                     (velocities along that line)
+//   f_sd = -ks (l0 - l) - kd (v1 - v2)              (1D force: spring + damper)
+//   f1 = f_sd e,    f2 = -f1                        (back to 3D, equal and opposite)
+//
+// A stretched spring (l > l0) pulls 1 toward 2; particles closing in (v1 > v2) are pushed apart
+// by the damper. Cloth is a grid of these: structural springs along rows and columns, shear
+// springs along the diagonals of each cell, and (lesson 04) bending springs two apart.
+#pragma once
+
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "clothlab/effect.hpp"
+
+namespace clothlab {
+
+// Exercise 2.1: the force [N] a spring-damper exerts on particle 1 (the force on particle 2 is
+// its negative), for positions r1, r2 [m], velocities v1, v2 [m/s], spring constant ks [N/m],
+// damping factor kd [N s/m] and rest length l0 [m]. Coincident particles (l = 0) have no
+// direction to push along: the force is zero, never NaN.
+Vec3 spring_damper_force(const Vec3& r1, const Vec3& r2, const Vec3& v1, const Vec3& v2, double ks,
+                         double kd, double l0);
+
+// Exercise 2.2: the energy [J] stored in the spring (not the damper), 1/2 ks (l - l0)^2.
+double spring_energy(const Vec3& r1, const Vec3& r2, double ks, double l0);
+
+// A family of springs as parallel arrays: spring k joins particles i[k] and j[k].
+struct SpringSet {
+  std::vector<Index> i, j;
+  std::vector<double> ks;  // spring constants [N/m]
+  std::vector<double> kd;  // damping factors [N s/m]
+  std::vector<double> l0;  // rest lengths [m]
+
+  size_t size() const { return i.size(); }
+  // Adds a spring from a to b; l0 < 0 means "the distance between them in x".
+  void add(Index a, Index b, double ks_ab, double kd_ab, double l0_ab, const Matrix3X& x);
+};
+
+// Appends one spring per pair (a, b), joining particles first + a and first + b, with rest
+// lengths measured in x (the distance at build time).
+void add_spring_family(SpringSet& springs, const std::vector<std::pair<Index, Index>>& pairs,
+                       Index first, double ks, double kd, const Matrix3X& x);
+
+// The force effect of one or more spring families: "springs" (structural, shear and springs
+// given one by one) or "bending".
+class SpringDampers final : public ForceEffect {
+ public:
+  SpringDampers(std::string name, SpringSet springs)
+      : name_(std::move(name)), springs_(std::move(springs)) {}
+  std::string_view name() const override { return name_; }
+  void add_forces(const Particles& p, const Matrix3X& x, const Matrix3X& v,
+                  Matrix3X& f) const override;
+  double potential_energy(const Particles& p, const Matrix3X& x) const override;
+  const SpringSet& springs() const { return springs_; }
+  SpringSet& springs() { return springs_; }
+
+ private:
+  std::string name_;
+  SpringSet springs_;
+};
+
+}  // namespace clothlab
