@@ -7,6 +7,7 @@
 
 #include "clothlab/aerodynamics.hpp"
 #include "clothlab/bending.hpp"
+#include "clothlab/damping.hpp"
 #include "clothlab/gravitation.hpp"
 #include "clothlab/gravity.hpp"
 
@@ -157,6 +158,12 @@ void read_bending(SceneTable& t, Scene& scene) {
       std::make_unique<SpringDampers>("bending", std::move(bending)));
 }
 
+// [damping]: a damper from every particle to the world, f = -rate m v (lesson 02).
+void read_damping(SceneTable& t, Scene& scene) {
+  const double rate = t.required_number("rate", Range::non_negative("1/s"));
+  scene.world.force_effects.push_back(std::make_unique<Damping>(rate));
+}
+
 // [aerodynamics]: air on the cloth's triangles (lesson 03).
 void read_aerodynamics(SceneTable& t, Scene& scene) {
   if (!scene.cloth) {
@@ -236,6 +243,7 @@ constexpr std::array kKinds = {
     SceneTableKind{"springs", false, false, "ks kd shear_ks shear_kd", "[springs] with ks",
                    read_springs},
     SceneTableKind{"bending", false, false, "ks kd", "[bending] with ks", read_bending},
+    SceneTableKind{"damping", false, false, "rate", "[damping] with rate", read_damping},
     SceneTableKind{"gravity", false, false, "g", "[gravity] with g", read_gravity},
     SceneTableKind{"gravitation", false, false, "G", "[gravitation] with G", read_gravitation},
     SceneTableKind{"aerodynamics", false, false, "rho cd wind",

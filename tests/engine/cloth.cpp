@@ -1,0 +1,217 @@
+// Cloth made of spring-dampers (lessons 02-04): the properties the whole engine must keep.
+#include <doctest/doctest.h>
+
+#include <cstring>
+#include <limits>
+#include <string>
+
+#include "clothlab/aerodynamics.hpp"
+#include "clothlab/bending.hpp"
+#include "clothlab/cloth.hpp"
+#include "clothlab/gravity.hpp"
+#include "clothlab/scene.hpp"
+#include "clothlab/spring_damper.hpp"
+
+using clothlab::Index;
+using clothlab::Vec3;
+
+namespace {
+
+// A light cloth, 12 x 12 particles 4 cm apart, 0.1 kg in all, held by two corners of one edge.
+// It starts flat and horizontal, so it falls and swings down into a hanging drape. (A cloth
+// that starts hanging in a vertical plane would only stretch: every force, gravity included,
+// stays in its plane.)
+const char* kHangingCloth = R"(
+[cloth]
+rows = 12
+cols = 12
+spacing = 0.04
+plane = "horizontal"
+mass = 0.1
+pins = "top-corners"
+[springs]
+ks = 60
+kd = 0.02
+[bending]
+ks = 5
+kd = 0.002
+[gravity]
+[integrator]
+dt = 0.0005
+duration = 1
+)";
+
+const clothlab::SpringDampers* find_springs(const clothlab::World& world, std::string_view name) {
+  for (const auto& e : world.force_effects) {
+    if (e->name() == name) return dynamic_cast<const clothlab::SpringDampers*>(e.get());
+  }
+  return nullptr;
+}
+
+// Sets every velocity to a fixed pseudo-random kick (the same on every run) [m/s].
+void kick(clothlab::World& world) {
+  unsigned state = 12345u;
+  auto next = [&] {
+    state = state * 1664525u + 1013904223u;  // a linear congruential generator
+    return static_cast<double>(state >> 8) / static_cast<double>(1u << 24) - 0.5;
+  };
+  for (Index i = 0; i < world.particles.size(); ++i) {
+    if (world.particles.inv_m[i] == 0.0) continue;
+    world.particles.v.col(i) = Vec3(next(), next(), next());
+  }
+}
+
+}  // namespace
+
+TEST_CASE("cloth: a grid has the spring counts the lecture's pictures give") {
+  // rows x cols particles: structural r(c-1) + c(r-1), shear 2(r-1)(c-1),
+  // bending r(c-2) + c(r-2). For 12 x 12: 264, 242 and 240.
+  clothlab::Scene scene = clothlab::parse_scene(kHangingCloth, "hanging.toml");
+  const auto* springs = find_springs(scene.world, "springs");
+  const auto* bending = find_springs(scene.world, "bending");
+  REQUIRE(springs != nullptr);
+  REQUIRE(bending != nullptr);
+  CHECK(springs->springs().size() == 264 + 242);
+  CHECK(bending->springs().size() == 240);
+  CHECK(scene.world.triangles.size() == 2 * 11 * 11);
+  // Rest lengths are the build-time distances: 4 cm, 4 cm * sqrt(2) and 8 cm.
+  for (double l0 : bending->springs().l0)
+    CHECK(l0 == doctest::Approx(0.08));
+}
+
+TEST_CASE("cloth: internal forces conserve momentum for every integrator") {
+  // Springs, dampers and bending act in equal and opposite pairs: with no pins and no gravity,
+  // total momentum stays what the kick gave, to rounding.
+  std::string text = kHangingCloth;
+  text.replace(text.find("pins = \"top-corners\""), 20, "pins = \"none\"");
+  text.replace(text.find("[gravity]"), 9, "");
+  for (const char* method : {"symplectic-euler", "explicit-euler"}) {
+    CAPTURE(method);
+    std::string with_method = text;
+    with_method.replace(with_method.find("dt = 0.0005"), 11,
+                        std::string("dt = 0.0002\nmethod = \"") + method + "\"");
+    clothlab::Scene scene = clothlab::parse_scene(with_method, "free.toml");
+    kick(scene.world);
+    const Vec3 p0 = scene.world.momentum();
+    for (int s = 0; s < 500; ++s)
+      scene.world.step(scene.dt);
+    CHECK((scene.world.momentum() - p0).norm() < 1e-13);
+    CHECK(scene.world.particles.x.allFinite());
+  }
+}
+
+TEST_CASE("cloth: pinned particles stay bitwise fixed") {
+  clothlab::Scene scene = clothlab::parse_scene(kHangingCloth, "hanging.toml");
+  const clothlab::Matrix3X x0 = scene.world.particles.x;
+  for (long s = 0; s < scene.step_count(); ++s)
+    scene.world.step(scene.dt);
+  const Index top_right = 11;
+  for (Index i : {Index{0}, top_right}) {
+    CAPTURE(i);
+    CHECK(std::memcmp(scene.world.particles.x.col(i).data(), x0.col(i).data(),
+                      3 * sizeof(double)) == 0);
+    CHECK(scene.world.particles.v.col(i).isZero(0.0));
+  }
+  // ... while the rest of the cloth has swung down: the far edge falls by tens of centimetres.
+  CHECK((scene.world.particles.x - x0).colwise().norm().maxCoeff() > 0.1);
+}
+
+TEST_CASE("cloth: a hanging cloth settles under gravity") {
+  // The cloth swings down like a pendulum. The spring dampers calm its stretching, but a swing
+  // about the pins stretches no spring: [damping] (f = -rate m v) calms that. With symplectic
+  // Euler at the scene's dt the kinetic energy, about 1e-2 J at its peak, falls below 1e-6 J
+  // and stays there.
+  std::string text = kHangingCloth;
+  text.replace(text.find("duration = 1"), 12, "duration = 30");
+  text += "[damping]\nrate = 1.0\n";
+  clothlab::Scene scene = clothlab::parse_scene(text, "settle.toml");
+  double peak = 0.0;
+  long calm_since = -1;
+  for (long s = 0; s < scene.step_count(); ++s) {
+    scene.world.step(scene.dt);
+    const double ke = scene.world.kinetic_energy();
+    peak = std::max(peak, ke);
+    if (ke < 1e-6) {
+      if (calm_since < 0) calm_since = s;
+    } else {
+      calm_since = -1;  // it moved again: not settled yet
+    }
+  }
+  CAPTURE(scene.world.kinetic_energy());
+  CHECK(peak > 1e-3);
+  REQUIRE(calm_since >= 0);
+  CHECK(calm_since < 2 * scene.step_count() / 3);  // settled by t = 20 s and stayed so
+}
+
+TEST_CASE("cloth: a zero-length spring between coincident particles stays finite") {
+  clothlab::Scene scene = clothlab::parse_scene(R"(
+[[particle]]
+position = [0, 0, 0]
+mass = 1
+[[particle]]
+position = [0, 0, 0]
+mass = 1
+[[spring]]
+i = 0
+j = 1
+ks = 100
+kd = 1
+l0 = 0.5
+[gravity]
+[integrator]
+dt = 0.001
+duration = 0.1
+)",
+                                                "coincident.toml");
+  for (long s = 0; s < scene.step_count(); ++s)
+    scene.world.step(scene.dt);
+  CHECK(scene.world.particles.x.allFinite());
+}
+
+TEST_CASE("cloth: a scene without [aerodynamics] never touches a triangle") {
+  // Poison every triangle with an index far outside the particle arrays: reading one would
+  // crash. The cloth still has springs, bending and gravity, and steps normally.
+  clothlab::Scene scene = clothlab::parse_scene(kHangingCloth, "hanging.toml");
+  REQUIRE(!scene.world.triangles.empty());
+  const Index poison = std::numeric_limits<Index>::max() / 64;
+  for (auto& t : scene.world.triangles)
+    t = {poison, poison, poison};
+  for (int s = 0; s < 100; ++s)
+    scene.world.step(scene.dt);
+  CHECK(scene.world.particles.x.allFinite());
+  for (const auto& e : scene.world.force_effects)
+    CHECK(e->name() != "aerodynamics");
+}
+
+TEST_CASE("cloth: air slows a falling sheet") {
+  // A horizontal sheet dropped flat: with [aerodynamics] it must fall more slowly than without.
+  const std::string sheet = R"(
+[cloth]
+rows = 6
+cols = 6
+spacing = 0.1
+plane = "horizontal"
+origin = [0, 10, 0]
+mass = 0.05
+[springs]
+ks = 50
+kd = 0.05
+[gravity]
+[integrator]
+dt = 0.0005
+duration = 1
+)";
+  clothlab::Scene still = clothlab::parse_scene(sheet, "vacuum.toml");
+  clothlab::Scene airy = clothlab::parse_scene(sheet + "[aerodynamics]\n", "air.toml");
+  for (long s = 0; s < still.step_count(); ++s) {
+    still.world.step(still.dt);
+    airy.world.step(airy.dt);
+  }
+  const double fall_vacuum = 10.0 - still.world.particles.x.row(1).mean();
+  const double fall_air = 10.0 - airy.world.particles.x.row(1).mean();
+  CHECK(fall_vacuum == doctest::Approx(4.9).epsilon(0.01));  // 1/2 g t^2, t = 1 s
+  CHECK(fall_air < 0.5 * fall_vacuum);
+  // Air pushes along the normal only: a flat sheet falling straight down is not pushed sideways.
+  CHECK(std::abs(airy.world.momentum().x()) < 1e-9);
+  CHECK(std::abs(airy.world.momentum().z()) < 1e-9);
+}
