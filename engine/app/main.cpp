@@ -68,7 +68,8 @@ std::string particle_count(const Scene& scene) {
   return fmt::format("{} particle{}", n, n == 1 ? "" : "s");
 }
 
-int run(Scene& scene, const fs::path& out_dir) {
+int run(Scene& scene, const RunOutputs& outputs) {
+  const fs::path& out_dir = outputs.dir;
   fmt::print("clothlab ({} build): {}{}\n", app::kKernels, scene.source,
              scene.title.empty() ? "" : " - " + scene.title);
   fmt::print("  {}; {}; dt = {} s for {} s ({} steps)\n", particle_count(scene),
@@ -76,7 +77,7 @@ int run(Scene& scene, const fs::path& out_dir) {
   const double energy_start = scene.world.kinetic_energy() + scene.world.potential_energy();
   ProgressBar bar;
   try {
-    const RunReport report = run_scene(scene, out_dir, std::ref(bar));
+    const RunReport report = run_scene(scene, outputs, std::ref(bar));
     const double energy_end = scene.world.kinetic_energy() + scene.world.potential_energy();
     fmt::print("  done: {} steps in {:.3f} s; total energy {:.6g} J -> {:.6g} J\n", report.steps,
                report.wall_seconds, energy_start, energy_end);
@@ -89,7 +90,8 @@ int run(Scene& scene, const fs::path& out_dir) {
     std::fflush(stdout);  // what was said before the error comes before it
     if (bar.shown()) fmt::print(stderr, "\n");
     fmt::print(stderr, "error: {}\n", error.what());
-    fmt::print(stderr, "  frames up to step {} are in {}/\n", error.step() - 1, out_dir.string());
+    fmt::print(stderr, "  frames up to step {} are in {}/{}\n", error.step() - 1, out_dir.string(),
+               outputs.html.empty() ? "" : fmt::format(" and {}", outputs.html.string()));
     return kBlewUp;
   }
 }
@@ -109,6 +111,12 @@ int main(int argc, char** argv) {
   CLI::App* run_cmd = app.add_subcommand("run", "Simulate a scene and write its frames");
   run_cmd->add_option("scene", scene_path, "Scene file (.toml)")->required();
   run_cmd->add_option("--out", out_dir, "Output folder (default: clothlab-out/<scene name>)");
+  std::string html;
+  bool no_html = false, obj = false, vtk = false;
+  run_cmd->add_option("--html", html, "Viewer page to write (default: <output folder>/view.html)");
+  run_cmd->add_flag("--no-html", no_html, "Write no viewer page");
+  run_cmd->add_flag("--obj", obj, "Also write an OBJ sequence to <output folder>/frames/");
+  run_cmd->add_flag("--vtk", vtk, "Also write a VTK series to <output folder>/frames/");
 
   std::string validate_path;
   CLI::App* validate_cmd = app.add_subcommand("validate", "Check a scene without running it");
@@ -126,7 +134,13 @@ int main(int argc, char** argv) {
   try {
     if (*run_cmd) {
       Scene scene = load_scene_file(scene_path);
-      return run(scene, out_dir.empty() ? default_out_dir(scene_path) : fs::path(out_dir));
+      RunOutputs outputs =
+          RunOutputs::in(out_dir.empty() ? default_out_dir(scene_path) : fs::path(out_dir));
+      if (!html.empty()) outputs.html = html;
+      if (no_html) outputs.html.clear();
+      outputs.obj = obj;
+      outputs.vtk = vtk;
+      return run(scene, outputs);
     }
     if (*validate_cmd) {
       const Scene scene = load_scene_file(validate_path);
@@ -138,7 +152,7 @@ int main(int argc, char** argv) {
     if (app.get_subcommands().empty()) {
       // No command: the demo, so that a first run shows something move.
       Scene scene = parse_scene(app::kDemoScene, app::kDemoSceneSource);
-      return run(scene, fs::path("clothlab-out") / "demo");
+      return run(scene, RunOutputs::in(fs::path("clothlab-out") / "demo"));
     }
   } catch (const SceneError& error) {
     std::fflush(stdout);

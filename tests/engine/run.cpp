@@ -2,8 +2,10 @@
 #include <doctest/doctest.h>
 
 #include <algorithm>
+#include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -108,4 +110,82 @@ max_position = 1.0
   for (const std::string& line : energy)
     CHECK(std::count(line.begin(), line.end(), ',') == 7);
   CHECK(energy.back().find("nan") == std::string::npos);
+}
+
+TEST_CASE("run: OBJ and VTK frames carry the mesh, normals, velocities and strains") {
+  clothlab::Scene scene = clothlab::parse_scene(R"(
+[cloth]
+rows = 3
+cols = 4
+spacing = 0.1
+mass = 0.12
+pins = "top-corners"
+[springs]
+ks = 50
+[gravity]
+[integrator]
+dt = 0.001
+duration = 0.01
+[output]
+fps = 500
+)",
+                                                "small.toml");
+  const fs::path dir = fresh_dir("meshes");
+  clothlab::RunOutputs outputs = clothlab::RunOutputs::in(dir);
+  outputs.obj = outputs.vtk = true;
+  const clothlab::RunReport report = clothlab::run_scene(scene, outputs);
+  REQUIRE(report.frames == 6);  // t = 0, 0.002, ..., 0.01
+  // OBJ: 12 vertices, 12 normals, 2 triangles per cell of the 2 x 3 cells, counted from 1.
+  const auto obj = read_lines(dir / "frames" / "frame_0001.obj");
+  const auto count = [&](const std::vector<std::string>& lines, const std::string& prefix) {
+    return std::count_if(lines.begin(), lines.end(),
+                         [&](const std::string& l) { return l.rfind(prefix, 0) == 0; });
+  };
+  CHECK(count(obj, "v ") == 12);
+  CHECK(count(obj, "vn ") == 12);
+  CHECK(count(obj, "f ") == 12);
+  CHECK(std::find(obj.begin(), obj.end(), "f 1//1 5//5 2//2") != obj.end());
+  // A vertical cloth in the x-y plane: every normal is +-z.
+  CHECK(std::find(obj.begin(), obj.end(), "vn 0 0 1") != obj.end());
+  CHECK(fs::exists(dir / "frames" / "frame_0006.obj"));
+  // VTK: the springs (structural 3*3 + 2*4 = 17, shear 2*2*3 = 12) as lines, with strain 0 at
+  // rest in the first frame, and a velocity per point.
+  const auto vtk = read_lines(dir / "frames" / "frame_0001.vtk");
+  CHECK(std::find(vtk.begin(), vtk.end(), "LINES 29 87") != vtk.end());
+  CHECK(std::find(vtk.begin(), vtk.end(), "POLYGONS 12 48") != vtk.end());
+  CHECK(std::find(vtk.begin(), vtk.end(), "CELL_DATA 41") != vtk.end());
+  CHECK(std::find(vtk.begin(), vtk.end(), "VECTORS velocity double") != vtk.end());
+  const auto strain = std::find(vtk.begin(), vtk.end(), "LOOKUP_TABLE default");
+  REQUIRE(strain != vtk.end());
+  for (int k = 1; k <= 29; ++k)
+    CHECK(std::abs(std::stod(*(strain + k))) < 1e-12);
+  // The series index lists the six files with their times.
+  const auto series = read_lines(dir / "frames" / "frames.vtk.series");
+  CHECK(count(series, "    {\"name\": \"frame_") == 6);
+  CHECK(fs::exists(dir / "view.html"));
+}
+
+TEST_CASE("run: the viewer page embeds every frame and names the scene") {
+  clothlab::Scene scene = clothlab::parse_scene(R"(
+title = "a </script> in a title must not end the page's script"
+[[particle]]
+position = [0, 0, 0]
+velocity = [1, 0, 0]
+mass = 1
+[integrator]
+dt = 0.1
+duration = 1
+[output]
+fps = 10
+)",
+                                                "page.toml");
+  const fs::path dir = fresh_dir("page");
+  clothlab::run_scene(scene, dir);
+  std::ifstream in(dir / "view.html");
+  const std::string page((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  CHECK(page.find("/*CLOTHLAB_DATA*/") == std::string::npos);  // the marker was replaced
+  CHECK(page.find("\"particles\":1,") != std::string::npos);
+  CHECK(page.find("\"times\":[0,0.1,") != std::string::npos);
+  CHECK(page.find("a <\\/script> in a title") != std::string::npos);
+  CHECK(page.find("a </script> in a title") == std::string::npos);
 }
