@@ -17,7 +17,8 @@ namespace clothlab {
 // Hints:
 //   1. v is the triangle's velocity relative to the air: subtract the wind.
 //   2. Use the folded form above: no normalize(), one norm of v and one of n*.
-//   3. If |n*| == 0 (a degenerate triangle) or |v| == 0 (no relative wind) return zero.
+//   3. A degenerate triangle has |n*| == 0: return zero rather than divide by it. (Written
+//      unfolded, with n = n* / |n*| and a = a0 (v . n) / |v|, you must also guard |v| == 0.)
 //   4. Check the sign: a triangle moving into still air along its normal is pushed back.
 Vec3 aerodynamic_force(const Vec3& r1, const Vec3& r2, const Vec3& r3, const Vec3& v1,
                        const Vec3& v2, const Vec3& v3, const Vec3& v_air, double rho, double cd) {

@@ -48,8 +48,8 @@ void Guard::check(const World& world) const {
   // place); a value that grows past any bound is energy that the integrator keeps adding.
   const char* advice =
       value.allFinite()
-          ? "A time step too large for the stiffness is the usual cause: try a smaller dt or "
-            "another integrator"
+          ? "A time step too large for the stiffness is the usual cause (try a smaller dt or "
+            "another integrator); a force with the wrong sign does the same at any dt"
           : "A NaN usually comes from a division by zero (a zero length, two particles at the "
             "same place) or from values that overflowed after growing without bound";
   throw SimulationError(
