@@ -68,8 +68,32 @@ std::string particle_count(const Scene& scene) {
   return fmt::format("{} particle{}", n, n == 1 ? "" : "s");
 }
 
-int run(Scene& scene, const RunOutputs& outputs) {
+// The --stats table: where the time of the run went, effect by effect (only those in play).
+void print_stats(const World& world, const StepTimes& times) {
+  double total = times.integrator + times.guard;
+  for (double s : times.force_effects)
+    total += s;
+  for (double s : times.post_step_effects)
+    total += s;
+  const auto row = [&](std::string_view name, double seconds) {
+    fmt::print("    {:<24} {:9.4f} s {:5.1f} %\n", name, seconds,
+               total > 0 ? 100.0 * seconds / total : 0.0);
+  };
+  fmt::print("  time per part of the step (--stats):\n");
+  for (size_t k = 0; k < times.force_effects.size(); ++k) {
+    row(world.force_effects[k]->name(), times.force_effects[k]);
+  }
+  for (size_t k = 0; k < times.post_step_effects.size(); ++k) {
+    row(world.post_step_effects[k]->name(), times.post_step_effects[k]);
+  }
+  row(fmt::format("{} (own)", world.integrator->name()), times.integrator);
+  row("guard", times.guard);
+}
+
+int run(Scene& scene, const RunOutputs& outputs, bool stats) {
   const fs::path& out_dir = outputs.dir;
+  StepTimes times;
+  if (stats) scene.world.timing = &times;
   fmt::print("clothlab ({} build): {}{}\n", app::kKernels, scene.source,
              scene.title.empty() ? "" : " - " + scene.title);
   fmt::print("  {}; {}; dt = {} s for {} s ({} steps)\n", particle_count(scene),
@@ -82,9 +106,15 @@ int run(Scene& scene, const RunOutputs& outputs) {
     fmt::print("  done: {} steps in {:.3f} s; total energy {:.6g} J -> {:.6g} J\n", report.steps,
                report.wall_seconds, energy_start, energy_end);
     fmt::print("  wrote {} frames to {}/: ", report.frames, out_dir.string());
-    for (const fs::path& file : report.files)
-      fmt::print("{} ", file.filename().string());
+    for (const fs::path& file : report.files) {
+      const bool inside = file.parent_path() == out_dir;
+      fmt::print("{} ", inside ? file.filename().string() : file.string());
+    }
     fmt::print("\n");
+    if (!outputs.html.empty()) {
+      fmt::print("  watch it: open {} in a browser\n", outputs.html.string());
+    }
+    if (stats) print_stats(scene.world, times);
     return 0;
   } catch (const SimulationError& error) {
     std::fflush(stdout);  // what was said before the error comes before it
@@ -112,11 +142,12 @@ int main(int argc, char** argv) {
   run_cmd->add_option("scene", scene_path, "Scene file (.toml)")->required();
   run_cmd->add_option("--out", out_dir, "Output folder (default: clothlab-out/<scene name>)");
   std::string html;
-  bool no_html = false, obj = false, vtk = false;
+  bool no_html = false, obj = false, vtk = false, stats = false;
   run_cmd->add_option("--html", html, "Viewer page to write (default: <output folder>/view.html)");
   run_cmd->add_flag("--no-html", no_html, "Write no viewer page");
   run_cmd->add_flag("--obj", obj, "Also write an OBJ sequence to <output folder>/frames/");
   run_cmd->add_flag("--vtk", vtk, "Also write a VTK series to <output folder>/frames/");
+  run_cmd->add_flag("--stats", stats, "Print the time spent in each effect of the scene");
 
   std::string validate_path;
   CLI::App* validate_cmd = app.add_subcommand("validate", "Check a scene without running it");
@@ -140,7 +171,7 @@ int main(int argc, char** argv) {
       if (no_html) outputs.html.clear();
       outputs.obj = obj;
       outputs.vtk = vtk;
-      return run(scene, outputs);
+      return run(scene, outputs, stats);
     }
     if (*validate_cmd) {
       const Scene scene = load_scene_file(validate_path);
@@ -152,7 +183,7 @@ int main(int argc, char** argv) {
     if (app.get_subcommands().empty()) {
       // No command: the demo, so that a first run shows something move.
       Scene scene = parse_scene(app::kDemoScene, app::kDemoSceneSource);
-      return run(scene, RunOutputs::in(fs::path("clothlab-out") / "demo"));
+      return run(scene, RunOutputs::in(fs::path("clothlab-out") / "demo"), false);
     }
   } catch (const SceneError& error) {
     std::fflush(stdout);

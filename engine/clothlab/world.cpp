@@ -1,23 +1,65 @@
 #include "clothlab/world.hpp"
 
 #include <cassert>
+#include <chrono>
 
 namespace clothlab {
 
+namespace {
+using Clock = std::chrono::steady_clock;
+double seconds_since(Clock::time_point start) {
+  return std::chrono::duration<double>(Clock::now() - start).count();
+}
+}  // namespace
+
 void World::step(double dt) {
   assert(integrator && "a world needs an integrator before it can step");
-  integrator->advance(*this, dt);  // calls compute_forces (steps 1-2) as often as it needs
-  for (const auto& effect : post_step_effects)
-    effect->apply(particles, dt);
+  if (!timing) {
+    integrator->advance(*this, dt);  // calls compute_forces (steps 1-2) as often as it needs
+    for (const auto& effect : post_step_effects)
+      effect->apply(particles, dt);
+    t += dt;
+    ++steps;
+    guard.check(*this);
+    return;
+  }
+  // The same step, timed part by part (for --stats).
+  timing->force_effects.resize(force_effects.size(), 0.0);
+  timing->post_step_effects.resize(post_step_effects.size(), 0.0);
+  double forces_before = 0.0;
+  for (double s : timing->force_effects)
+    forces_before += s;
+  Clock::time_point start = Clock::now();
+  integrator->advance(*this, dt);
+  double forces_after = 0.0;
+  for (double s : timing->force_effects)
+    forces_after += s;
+  timing->integrator += seconds_since(start) - (forces_after - forces_before);
+  for (size_t k = 0; k < post_step_effects.size(); ++k) {
+    start = Clock::now();
+    post_step_effects[k]->apply(particles, dt);
+    timing->post_step_effects[k] += seconds_since(start);
+  }
   t += dt;
   ++steps;
+  start = Clock::now();
   guard.check(*this);
+  timing->guard += seconds_since(start);
 }
 
 void World::compute_forces(const Matrix3X& x, const Matrix3X& v, Matrix3X& f) const {
   f.setZero();
-  for (const auto& effect : force_effects)
-    effect->add_forces(particles, x, v, f);
+  if (!timing) {
+    for (const auto& effect : force_effects)
+      effect->add_forces(particles, x, v, f);
+    return;
+  }
+  timing->force_effects.resize(force_effects.size(), 0.0);
+  for (size_t k = 0; k < force_effects.size(); ++k) {
+    const Clock::time_point start = Clock::now();
+    force_effects[k]->add_forces(particles, x, v, f);
+    timing->force_effects[k] += seconds_since(start);
+  }
 }
 
 double World::kinetic_energy() const {
