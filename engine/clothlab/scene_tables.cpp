@@ -147,12 +147,10 @@ void read_bending(SceneTable& t, Scene& scene) {
   const double ks = t.required_number("ks", Range::non_negative("N/m"));
   const double kd = t.number("kd", Range::non_negative("N s/m"), 0.0);
   const Matrix3X& x = scene.world.particles.x;
-  SpringSet bending;
-  if (scene.rope)
+  // The cloth's bending layer (exercise 4.1 picks its pairs), then the rope's, if any.
+  SpringSet bending = scene.cloth ? bending_springs(*scene.cloth, ks, kd, x) : SpringSet{};
+  if (scene.rope) {
     add_spring_family(bending, rope_bending_pairs(scene.rope->count), scene.rope->first, ks, kd, x);
-  if (scene.cloth) {
-    const ClothGrid& g = *scene.cloth;
-    add_spring_family(bending, bending_pairs(g.rows, g.cols), g.first, ks, kd, x);
   }
   scene.world.force_effects.push_back(
       std::make_unique<SpringDampers>("bending", std::move(bending)));
@@ -284,8 +282,10 @@ void finish_scene(Scene& scene, const std::function<void(const std::string&)>& f
   }
   // Structural, shear and one-by-one springs make one effect, built once all are known.
   if (scene.springs.size() > 0) {
-    scene.world.force_effects.push_back(
-        std::make_unique<SpringDampers>("springs", std::move(scene.springs)));
+    // First in the list, so reports read in the lessons' order: springs, bending, gravity, ...
+    auto& effects = scene.world.force_effects;
+    effects.insert(effects.begin(),
+                   std::make_unique<SpringDampers>("springs", std::move(scene.springs)));
     scene.springs = SpringSet{};
   }
 }
