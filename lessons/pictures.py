@@ -1,0 +1,58 @@
+#!/usr/bin/env python3
+"""Renders the picture at the top of each lesson: its scene, run by clothlab, drawn by the
+viewer page in headless Chromium, saved as lessons/NN-name/picture.png.
+
+    cmake --build build --target pictures      (or: python3 lessons/pictures.py build/clothlab)
+"""
+import os
+import shutil
+import subprocess
+import sys
+import tempfile
+
+# lesson folder -> (scene file, frame to show: a number, or -1 for the last)
+PICTURES = {
+    "01-particles-and-euler": ("two-bodies.toml", -1),
+    "02-spring-dampers": ("hanging-cloth.toml", -1),
+    "03-aerodynamics": ("flag.toml", 200),
+    "04-bending-springs": ("drape-stiff.toml", -1),
+}
+
+
+def main():
+    if len(sys.argv) != 2:
+        print(__doc__)
+        return 2
+    clothlab = os.path.abspath(sys.argv[1])
+    browser = shutil.which("chromium") or shutil.which("chromium-browser")
+    if not browser:
+        print("pictures: no chromium on this machine: sudo apt-get install -y chromium")
+        return 1
+    lessons = os.path.dirname(os.path.abspath(__file__))
+    root = os.path.dirname(lessons)
+    work = tempfile.mkdtemp(prefix="clothlab-pictures-")
+    try:
+        for lesson, (scene, frame) in PICTURES.items():
+            out = os.path.join(work, lesson)
+            page = os.path.join(out, "view.html")
+            # Run from the repository's root, so the page names the scene as lessons/...
+            subprocess.run([clothlab, "run", os.path.join("lessons", lesson, scene), "--out", out],
+                           check=True, stdout=subprocess.DEVNULL, cwd=root)
+            picture = os.path.join(lessons, lesson, "picture.png")
+            shown = 10**6 if frame < 0 else frame  # the viewer clamps to the last frame
+            subprocess.run(
+                [browser, "--headless", "--no-sandbox", "--disable-gpu", "--disable-quic",
+                 "--no-first-run", "--disable-background-networking",
+                 "--disable-component-update", "--disable-sync",
+                 f"--user-data-dir={os.path.join(work, 'profile')}", "--window-size=720,420",
+                 "--hide-scrollbars", "--virtual-time-budget=3000", f"--screenshot={picture}",
+                 f"file://{page}?frame={shown}&still"],
+                check=True, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, timeout=120)
+            print(f"pictures: {os.path.relpath(picture)} ({scene})")
+    finally:
+        shutil.rmtree(work, ignore_errors=True)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
