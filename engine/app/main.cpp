@@ -45,7 +45,9 @@ class ProgressBar {
     if (!enabled_) return;
     const auto now = std::chrono::steady_clock::now();
     const double elapsed = std::chrono::duration<double>(now - start_).count();
-    if (done != total && (elapsed < 0.5 || now - last_ < std::chrono::milliseconds(100))) return;
+    // Nothing for a run that ends within half a second; then at most ten updates a second.
+    if (elapsed < 0.5) return;
+    if (done != total && now - last_ < std::chrono::milliseconds(100)) return;
     last_ = now;
     shown_ = true;
     constexpr int kWidth = 30;
