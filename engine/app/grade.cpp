@@ -16,6 +16,8 @@
 #include <fmt/core.h>
 #include <CLI/CLI.hpp>
 
+#include "clothlab/json.hpp"
+
 #include <algorithm>
 #include <cerrno>
 #include <chrono>
@@ -568,20 +570,9 @@ std::string valid_utf8(const std::string& in) {
   return out;
 }
 
-std::string json_string(const std::string& text) {
-  std::string out = "\"";
-  for (char ch : valid_utf8(text)) {
-    if (ch == '"' || ch == '\\') {
-      out += {'\\', ch};
-    } else if (ch == '\n') {
-      out += "\\n";
-    } else if (static_cast<unsigned char>(ch) < 0x20) {
-      out += fmt::format("\\u{:04x}", static_cast<int>(ch));
-    } else {
-      out += ch;
-    }
-  }
-  return out + "\"";
+// JSON text of a report: invalid UTF-8 from a test's output replaced first.
+std::string json_text(const std::string& text) {
+  return clothlab::json_string(valid_utf8(text));
 }
 
 std::string xml_escape(const std::string& text) {
@@ -638,14 +629,14 @@ std::string gradescope_json(const std::vector<Case>& cases, double seconds,
     tests += fmt::format(
         "{}\n    {{\"name\": {}, \"number\": {}, \"score\": {}, \"max_score\": {}, "
         "\"status\": \"{}\", \"output\": {}, \"visibility\": \"visible\"}}",
-        tests.empty() ? "" : ",", json_string(c.name), json_string(number_of(c.exercise)),
+        tests.empty() ? "" : ",", json_text(c.name), json_text(number_of(c.exercise)),
         c.passed ? c.points : 0, c.points, c.passed ? "passed" : "failed",
-        json_string(case_report(c, true)));
+        json_text(case_report(c, true)));
   }
   return fmt::format(
       "{{\n  \"score\": {},\n  \"execution_time\": {:.3f},\n  \"output\": {},\n  \"tests\": [{}\n  "
       "]\n}}\n",
-      score, seconds, json_string(output), tests);
+      score, seconds, json_text(output), tests);
 }
 
 std::string junit_xml(const std::vector<Case>& cases, double seconds) {

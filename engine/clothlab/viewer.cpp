@@ -6,6 +6,7 @@
 
 #include <fmt/format.h>
 
+#include "clothlab/json.hpp"
 #include "clothlab/spring_damper.hpp"
 
 namespace clothlab {
@@ -32,25 +33,6 @@ std::string base64(const void* data, size_t size) {
     out += i + 2 < size ? kDigits[group & 63] : '=';
   }
   return out;
-}
-
-// A JSON string literal; "</" is written "<\/" so the text cannot close the <script> element.
-std::string json_string(std::string_view s) {
-  std::string out = "\"";
-  for (size_t k = 0; k < s.size(); ++k) {
-    const char ch = s[k];
-    if (ch == '"' || ch == '\\') {
-      out += '\\';
-      out += ch;
-    } else if (ch == '/' && k > 0 && s[k - 1] == '<') {
-      out += "\\/";
-    } else if (static_cast<unsigned char>(ch) < 0x20) {
-      out += fmt::format("\\u{:04x}", static_cast<int>(ch));
-    } else {
-      out += ch;
-    }
-  }
-  return out + "\"";
 }
 
 template <class T>
