@@ -10,6 +10,7 @@
 #include "clothlab/damping.hpp"
 #include "clothlab/gravitation.hpp"
 #include "clothlab/gravity.hpp"
+#include "clothlab/ground_collision.hpp"
 
 namespace clothlab {
 
@@ -204,6 +205,44 @@ void read_gravitation(SceneTable& t, Scene& scene) {
   scene.world.force_effects.push_back(std::make_unique<Gravitation>(G));
 }
 
+// The contact constants shared by [ground] and [sphere] (lesson 05).
+ContactMaterial read_material(SceneTable& t) {
+  ContactMaterial m;
+  m.e = t.number("e", Range{0.0, 1.0, false, ""}, m.e);
+  m.mu_s = t.number("mu_s", Range::non_negative(""), m.mu_s);
+  m.mu_d = t.number("mu_d", Range::non_negative(""), std::min(m.mu_d, m.mu_s));
+  m.rest_speed = t.number("rest_speed", Range::non_negative("m/s"), m.rest_speed);
+  if (m.mu_d > m.mu_s) {
+    t.fail("mu_d", fmt::format("mu_d = {} is larger than mu_s = {}; expected mu_d <= mu_s (sliding "
+                               "never grips harder than sticking)",
+                               m.mu_d, m.mu_s));
+  }
+  return m;
+}
+
+// [ground]: the plane y = y0, solid below (lesson 05).
+void read_ground(SceneTable& t, Scene& scene) {
+  const double y0 = t.number("y", Range::any("m"), 0.0);
+  const bool simple = t.choice("model", {"coulomb", "simple"}, "coulomb") == "simple";
+  const double friction = t.number("friction", Range{0.0, 1.0, false, ""}, 0.0);
+  if (!simple && t.has("friction")) {
+    t.fail("friction",
+           "'friction' belongs to model = \"simple\"; expected mu_s and mu_d for the "
+           "Coulomb model");
+  }
+  const ContactMaterial m = read_material(t);
+  scene.world.post_step_effects.push_back(std::make_unique<Ground>(
+      y0, m, simple ? Ground::Model::simple : Ground::Model::coulomb, friction));
+}
+
+// [sphere]: a solid ball (lesson 05).
+void read_sphere(SceneTable& t, Scene& scene) {
+  const Vec3 centre = t.required_vec3("centre", "m");
+  const double radius = t.required_number("radius", Range::positive("m"));
+  scene.world.post_step_effects.push_back(
+      std::make_unique<Sphere>(centre, radius, read_material(t)));
+}
+
 // [integrator]: the method, the time step and how long to simulate.
 void read_integrator(SceneTable& t, Scene& scene) {
   const std::vector<std::string_view> names(integrator_names().begin(), integrator_names().end());
@@ -249,6 +288,10 @@ constexpr std::array kKinds = {
     SceneTableKind{"drag", false, false, "rho cd area wind", "[drag] with area", read_drag},
     SceneTableKind{"buoyancy", false, false, "rho volume surface g", "[buoyancy] with volume",
                    read_buoyancy},
+    SceneTableKind{"ground", false, false, "y e mu_s mu_d rest_speed model friction",
+                   "[ground] with y, e, mu_s and mu_d", read_ground},
+    SceneTableKind{"sphere", false, false, "centre radius e mu_s mu_d rest_speed",
+                   "[sphere] with centre and radius", read_sphere},
     SceneTableKind{"integrator", false, true, "method dt duration",
                    "[integrator] with method, dt [s] and duration [s]", read_integrator},
     SceneTableKind{"output", false, false, "fps", "[output] with fps", read_output},

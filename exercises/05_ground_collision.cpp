@@ -1,0 +1,33 @@
+// Lesson 05, ground collision: the exercise kernel.
+//
+// exercises/ holds the stubs a student fills in; solutions/ holds the reference. The two files
+// are the same except inside the regions between "BEGIN exNN.k" and "END exNN.k": write your
+// answer there and leave the rest as it is. Grade your work with `./build/clothlab grade`.
+// Drop a cloth on the floor on your code with
+//   ./build/clothlab-student run lessons/05-ground-collision/cloth-on-floor.toml
+// Every symbol is explained in lessons/05-ground-collision/README.md.
+#include "clothlab/ground_collision.hpp"
+#include "clothlab/not_implemented.hpp"
+
+namespace clothlab {
+
+// Exercise 5.1: the response of a particle found `depth` inside a solid with outward normal n.
+//   r' = r + depth n                                   (back onto the surface)
+//   v_n = (v . n) n,  v_t = v - v_n
+//   if v . n < 0:  j = (1 + e) |v . n|,  v_n' = -e v_n  (bounce)
+//                  |v_t| <= mu_s j:  v_t' = 0           (static friction: it sticks)
+//                  otherwise:        v_t' = v_t (1 - mu_d j / |v_t|)   (dynamic: it slides)
+//   else (already moving out): the velocity is left as it is.
+// Hints:
+//   1. n is a unit vector; split v with one dot product.
+//   2. Friction acts only during a bounce: no approach, no impulse j, no friction.
+//   3. Dynamic friction slows the sliding but never reverses it: 1 - mu_d j / |v_t| > 0 whenever
+//      |v_t| > mu_s j and mu_d <= mu_s.
+PointState collision_response(const Vec3& r, const Vec3& v, const Vec3& n, double depth, double e,
+                              double mu_s, double mu_d) {
+  // BEGIN ex05.1: see lessons/05-ground-collision/README.md
+  CLOTHLAB_TODO("ex05.1", "lessons/05-ground-collision/README.md");
+  // END ex05.1
+}
+
+}  // namespace clothlab
