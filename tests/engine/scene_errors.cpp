@@ -120,13 +120,26 @@ TEST_CASE("scene error: a rope of no length") {
   check_bad_scene("rope_of_no_length.toml");
 }
 
+TEST_CASE("scene error: restitution above 1") {
+  check_bad_scene("restitution_above_one.toml");
+}
+TEST_CASE("scene error: dynamic friction above static friction") {
+  check_bad_scene("dynamic_above_static_friction.toml");
+}
+TEST_CASE("scene error: the simple model's friction in the Coulomb model") {
+  check_bad_scene("friction_in_coulomb_model.toml");
+}
+TEST_CASE("scene error: a sphere of radius 0") {
+  check_bad_scene("sphere_without_radius.toml");
+}
+
 TEST_CASE("scene error: every bad scene file has a test case") {
   // A file added to tests/scenes/bad/ without a test above would never be checked.
   int files = 0;
   for (const auto& entry : fs::directory_iterator(fs::path(CLOTHLAB_TEST_SCENES) / "bad")) {
     if (entry.path().extension() == ".toml") ++files;
   }
-  CHECK(files == 27);
+  CHECK(files == 31);
 }
 
 TEST_CASE("scene error: a missing file") {
