@@ -6,6 +6,7 @@
 
 #include <fmt/format.h>
 
+#include "clothlab/ground_collision.hpp"
 #include "clothlab/json.hpp"
 #include "clothlab/spring_damper.hpp"
 
@@ -70,6 +71,19 @@ void ViewerRecorder::write(const World& world, const std::filesystem::path& html
       }
     }
   }
+  // Colliders, drawn so that a student sees what the cloth lies on.
+  std::string colliders;
+  for (const auto& effect : world.post_step_effects) {
+    if (!colliders.empty()) colliders += ",";
+    if (const auto* g = dynamic_cast<const Ground*>(effect.get())) {
+      colliders += fmt::format("{{\"type\":\"ground\",\"y\":{}}}", g->y0());
+    } else if (const auto* b = dynamic_cast<const Sphere*>(effect.get())) {
+      colliders += fmt::format("{{\"type\":\"sphere\",\"centre\":[{},{},{}],\"radius\":{}}}",
+                               b->centre().x(), b->centre().y(), b->centre().z(), b->radius());
+    } else if (!colliders.empty()) {
+      colliders.pop_back();
+    }
+  }
   std::vector<Index> pins;
   for (Index i = 0; i < world.particles.size(); ++i) {
     if (world.particles.inv_m[i] == 0.0) pins.push_back(i);
@@ -86,10 +100,12 @@ void ViewerRecorder::write(const World& world, const std::filesystem::path& html
   frames += "]";
   const std::string json = fmt::format(
       "{{\"title\":{},\"source\":{},\"particles\":{},\"times\":{},\"kinetic\":{},"
-      "\"potential\":{},\"total\":{},\"triangles\":{},\"springs\":{},\"pins\":{},\"frames\":{}}}",
+      "\"potential\":{},\"total\":{},\"triangles\":{},\"springs\":{},\"pins\":{},\"colliders\":[{}]"
+      ","
+      "\"frames\":{}}}",
       json_string(title_), json_string(source_), world.particles.size(), json_array(times_),
       json_array(kinetic_), json_array(potential_), json_array(total), json_array(triangles),
-      json_array(springs), json_array(pins), frames);
+      json_array(springs), json_array(pins), colliders, frames);
 
   const std::string_view marker = "/*CLOTHLAB_DATA*/";
   const size_t at = kViewerTemplate.find(marker);
