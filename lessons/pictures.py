@@ -16,6 +16,7 @@ PICTURES = {
     "02-spring-dampers": ("hanging-cloth.toml", -1),
     "03-aerodynamics": ("flag.toml", 200),
     "04-bending-springs": ("drape-stiff.toml", -1),
+    "05-ground-collision": ("cloth-on-sphere.toml", -1),
 }
 
 

@@ -230,6 +230,15 @@ void read_ground(SceneTable& t, Scene& scene) {
            "'friction' belongs to model = \"simple\"; expected mu_s and mu_d for the "
            "Coulomb model");
   }
+  if (simple) {
+    for (std::string_view key : {"mu_s", "mu_d", "rest_speed"}) {
+      if (t.has(key)) {
+        t.fail(key, fmt::format("'{}' belongs to the Coulomb model; expected only e and friction "
+                                "with model = \"simple\"",
+                                key));
+      }
+    }
+  }
   const ContactMaterial m = read_material(t);
   scene.world.post_step_effects.push_back(std::make_unique<Ground>(
       y0, m, simple ? Ground::Model::simple : Ground::Model::coulomb, friction));
