@@ -46,6 +46,11 @@ class Aerodynamics final : public ForceEffect {
   // Wind may change while the simulation runs (a gust, a game's weather).
   void set_wind(const Vec3& v_air) { v_air_ = v_air; }
   const std::vector<Triangle>& triangles() const { return triangles_; }
+  // Drops the triangles a tear has opened (lesson 06).
+  template <class Predicate>
+  void remove_triangles_if(Predicate torn) {
+    std::erase_if(triangles_, torn);
+  }
 
  private:
   std::vector<Triangle> triangles_;

@@ -14,6 +14,8 @@
 
 namespace clothlab {
 
+class World;
+
 class ForceEffect {
  public:
   virtual ~ForceEffect() = default;
@@ -38,8 +40,10 @@ class PostStepEffect {
   virtual ~PostStepEffect() = default;
   virtual std::string_view name() const = 0;
 
-  // Applies the effect to the particles once the integrator has advanced them by dt [s].
-  virtual void apply(Particles& p, double dt) = 0;
+  // Applies the effect once the integrator has advanced the particles by dt [s]. It gets the
+  // whole world: some post-step effects change more than particles (tearing removes springs
+  // and triangles).
+  virtual void apply(World& world, double dt) = 0;
 };
 
 }  // namespace clothlab

@@ -2,6 +2,8 @@
 
 #include <cmath>
 
+#include "clothlab/world.hpp"
+
 namespace clothlab {
 
 namespace {
@@ -17,7 +19,8 @@ PointState respond(const Vec3& r, const Vec3& v, const Vec3& n, double depth,
 
 }  // namespace
 
-void Ground::apply(Particles& p, double /*dt*/) {
+void Ground::apply(World& world, double /*dt*/) {
+  Particles& p = world.particles;
   const Vec3 up = Vec3::UnitY();
   for (Index i = 0; i < p.size(); ++i) {
     const double depth = y0_ - p.x(1, i);
@@ -37,7 +40,8 @@ void Ground::apply(Particles& p, double /*dt*/) {
   }
 }
 
-void Sphere::apply(Particles& p, double /*dt*/) {
+void Sphere::apply(World& world, double /*dt*/) {
+  Particles& p = world.particles;
   for (Index i = 0; i < p.size(); ++i) {
     const Vec3 d = p.x.col(i) - centre_;
     const double distance = d.norm();

@@ -44,7 +44,7 @@ class Ground final : public PostStepEffect {
   Ground(double y0, const ContactMaterial& material, Model model, double friction)
       : y0_(y0), material_(material), model_(model), friction_(friction) {}
   std::string_view name() const override { return "ground"; }
-  void apply(Particles& p, double dt) override;
+  void apply(World& world, double dt) override;
   double y0() const { return y0_; }
 
  private:
@@ -60,7 +60,7 @@ class Sphere final : public PostStepEffect {
   Sphere(const Vec3& centre, double radius, const ContactMaterial& material)
       : centre_(centre), radius_(radius), material_(material) {}
   std::string_view name() const override { return "sphere"; }
-  void apply(Particles& p, double dt) override;
+  void apply(World& world, double dt) override;
   const Vec3& centre() const { return centre_; }
   double radius() const { return radius_; }
 

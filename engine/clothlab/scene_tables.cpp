@@ -11,6 +11,8 @@
 #include "clothlab/gravitation.hpp"
 #include "clothlab/gravity.hpp"
 #include "clothlab/ground_collision.hpp"
+#include "clothlab/plasticity.hpp"
+#include "clothlab/tearing.hpp"
 
 namespace clothlab {
 
@@ -252,6 +254,31 @@ void read_sphere(SceneTable& t, Scene& scene) {
       std::make_unique<Sphere>(centre, radius, read_material(t)));
 }
 
+// [plasticity]: springs whose rest length yields past an elastic limit (lesson 06).
+void read_plasticity(SceneTable& t, Scene& scene) {
+  if (scene.springs.size() == 0) {
+    t.fail("yield_strain",
+           "[plasticity] has no springs to deform; expected [springs] or "
+           "[[spring]] tables");
+  }
+  PlasticLimits limits;
+  limits.yield_strain = t.required_number("yield_strain", Range{0.0, 0.99, true, ""});
+  limits.flow_rate = t.number("flow_rate", Range::positive("1/s"), limits.flow_rate);
+  limits.max_strain = t.number("max_strain", Range{0.0, 0.99, false, ""}, limits.max_strain);
+  scene.world.post_step_effects.push_back(std::make_unique<Plasticity>(limits));
+}
+
+// [tearing]: springs that break past a tearing limit, and the triangles they edge (lesson 06).
+void read_tearing(SceneTable& t, Scene& scene) {
+  if (scene.springs.size() == 0) {
+    t.fail("strain", "[tearing] has no springs to tear; expected [springs] or [[spring]] tables");
+  }
+  const double strain = t.required_number("strain", Range::positive(""));
+  const long max_tears = t.integer("max_per_step", 0, 1000000000, 0);
+  scene.world.post_step_effects.push_back(
+      std::make_unique<Tearing>(strain, static_cast<size_t>(max_tears)));
+}
+
 // [integrator]: the method, the time step and how long to simulate.
 void read_integrator(SceneTable& t, Scene& scene) {
   const std::vector<std::string_view> names(integrator_names().begin(), integrator_names().end());
@@ -301,6 +328,10 @@ constexpr std::array kKinds = {
                    "[ground] with y, e, mu_s and mu_d", read_ground},
     SceneTableKind{"sphere", false, false, "centre radius e mu_s mu_d rest_speed",
                    "[sphere] with centre and radius", read_sphere},
+    SceneTableKind{"plasticity", false, false, "yield_strain flow_rate max_strain",
+                   "[plasticity] with yield_strain", read_plasticity},
+    SceneTableKind{"tearing", false, false, "strain max_per_step", "[tearing] with strain",
+                   read_tearing},
     SceneTableKind{"integrator", false, true, "method dt duration",
                    "[integrator] with method, dt [s] and duration [s]", read_integrator},
     SceneTableKind{"output", false, false, "fps", "[output] with fps", read_output},

@@ -8,6 +8,29 @@ void SpringSet::add(Index a, Index b, double ks_ab, double kd_ab, double l0_ab, 
   ks.push_back(ks_ab);
   kd.push_back(kd_ab);
   l0.push_back(l0_ab >= 0.0 ? l0_ab : (x.col(b) - x.col(a)).norm());
+  l_built.push_back(l0.back());
+}
+
+void SpringSet::erase(const std::vector<size_t>& positions) {
+  // One pass: copy every spring not removed down over the gaps the removed ones leave.
+  size_t kept = 0, next = 0;
+  for (size_t k = 0; k < size(); ++k) {
+    if (next < positions.size() && positions[next] == k) {
+      ++next;
+      continue;
+    }
+    i[kept] = i[k];
+    j[kept] = j[k];
+    ks[kept] = ks[k];
+    kd[kept] = kd[k];
+    l0[kept] = l0[k];
+    l_built[kept] = l_built[k];
+    ++kept;
+  }
+  for (auto* column : {&ks, &kd, &l0, &l_built})
+    column->resize(kept);
+  i.resize(kept);
+  j.resize(kept);
 }
 
 void add_spring_family(SpringSet& springs, const std::vector<std::pair<Index, Index>>& pairs,

@@ -34,13 +34,16 @@ double spring_energy(const Vec3& r1, const Vec3& r2, double ks, double l0);
 // A family of springs as parallel arrays: spring k joins particles i[k] and j[k].
 struct SpringSet {
   std::vector<Index> i, j;
-  std::vector<double> ks;  // spring constants [N/m]
-  std::vector<double> kd;  // damping factors [N s/m]
-  std::vector<double> l0;  // rest lengths [m]
+  std::vector<double> ks;       // spring constants [N/m]
+  std::vector<double> kd;       // damping factors [N s/m]
+  std::vector<double> l0;       // rest lengths [m]; plasticity (lesson 06) may change them
+  std::vector<double> l_built;  // rest lengths as built [m], for plastic strain limits
 
   size_t size() const { return i.size(); }
   // Adds a spring from a to b; l0 < 0 means "the distance between them in x".
   void add(Index a, Index b, double ks_ab, double kd_ab, double l0_ab, const Matrix3X& x);
+  // Removes the springs at the given positions (ascending), keeping the others in order.
+  void erase(const std::vector<size_t>& positions);
 };
 
 // Appends one spring per pair (a, b), joining particles first + a and first + b, with rest

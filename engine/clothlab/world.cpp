@@ -17,7 +17,7 @@ void World::step(double dt) {
   if (!timing) {
     integrator->advance(*this, dt);  // calls compute_forces (steps 1-2) as often as it needs
     for (const auto& effect : post_step_effects)
-      effect->apply(particles, dt);
+      effect->apply(*this, dt);
     t += dt;
     ++steps;
     guard.check(*this);
@@ -37,7 +37,7 @@ void World::step(double dt) {
   timing->integrator += seconds_since(start) - (forces_after - forces_before);
   for (size_t k = 0; k < post_step_effects.size(); ++k) {
     start = Clock::now();
-    post_step_effects[k]->apply(particles, dt);
+    post_step_effects[k]->apply(*this, dt);
     timing->post_step_effects[k] += seconds_since(start);
   }
   t += dt;

@@ -1,0 +1,26 @@
+#include "clothlab/plasticity.hpp"
+
+#include "clothlab/spring_damper.hpp"
+#include "clothlab/world.hpp"
+
+namespace clothlab {
+
+SpringDampers* find_spring_effect(World& world, std::string_view name) {
+  for (auto& effect : world.force_effects) {
+    if (effect->name() == name) return dynamic_cast<SpringDampers*>(effect.get());
+  }
+  return nullptr;
+}
+
+void Plasticity::apply(World& world, double dt) {
+  SpringDampers* springs = find_spring_effect(world, "springs");
+  if (!springs) return;
+  SpringSet& s = springs->springs();
+  const Matrix3X& x = world.particles.x;
+  for (size_t k = 0; k < s.size(); ++k) {
+    const double l = (x.col(s.j[k]) - x.col(s.i[k])).norm();
+    s.l0[k] = plastic_rest_length(l, s.l0[k], s.l_built[k], limits_, dt);
+  }
+}
+
+}  // namespace clothlab

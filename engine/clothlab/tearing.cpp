@@ -1,0 +1,49 @@
+#include "clothlab/tearing.hpp"
+
+#include <algorithm>
+#include <set>
+
+#include "clothlab/aerodynamics.hpp"
+#include "clothlab/spring_damper.hpp"
+#include "clothlab/world.hpp"
+
+namespace clothlab {
+
+SpringDampers* find_spring_effect(World& world, std::string_view name);  // plasticity.cpp
+
+void Tearing::apply(World& world, double /*dt*/) {
+  SpringDampers* effect = find_spring_effect(world, "springs");
+  if (!effect) return;
+  SpringSet& s = effect->springs();
+  const Matrix3X& x = world.particles.x;
+  std::vector<double> strain(s.size());
+  std::vector<std::pair<Index, Index>> ends(s.size());
+  for (size_t k = 0; k < s.size(); ++k) {
+    strain[k] = (x.col(s.j[k]) - x.col(s.i[k])).norm() / s.l0[k] - 1.0;
+    ends[k] = {std::min(s.i[k], s.j[k]), std::max(s.i[k], s.j[k])};
+  }
+  const std::vector<size_t> torn = select_tears(strain, ends, tear_strain_, max_tears_);
+  if (torn.empty()) return;
+
+  // The torn edges, then every triangle that had one of them as a side.
+  std::set<std::pair<Index, Index>> gone;
+  for (size_t k : torn)
+    gone.insert(ends[k]);
+  s.erase(torn);
+  torn_ += static_cast<long>(torn.size());
+  const auto has_torn_edge = [&](const Triangle& t) {
+    for (int a = 0; a < 3; ++a) {
+      const Index p = t[a], q = t[(a + 1) % 3];
+      if (gone.count({std::min(p, q), std::max(p, q)}) != 0) return true;
+    }
+    return false;
+  };
+  std::erase_if(world.triangles, has_torn_edge);
+  for (auto& force : world.force_effects) {
+    if (auto* aero = dynamic_cast<Aerodynamics*>(force.get())) {
+      aero->remove_triangles_if(has_torn_edge);
+    }
+  }
+}
+
+}  // namespace clothlab
