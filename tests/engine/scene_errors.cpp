@@ -133,13 +133,23 @@ TEST_CASE("scene error: a sphere of radius 0") {
   check_bad_scene("sphere_without_radius.toml");
 }
 
+TEST_CASE("scene error: plasticity without springs") {
+  check_bad_scene("plasticity_without_springs.toml");
+}
+TEST_CASE("scene error: a yield strain above 0.99") {
+  check_bad_scene("yield_strain_out_of_range.toml");
+}
+TEST_CASE("scene error: a negative tearing strain") {
+  check_bad_scene("negative_tear_strain.toml");
+}
+
 TEST_CASE("scene error: every bad scene file has a test case") {
   // A file added to tests/scenes/bad/ without a test above would never be checked.
   int files = 0;
   for (const auto& entry : fs::directory_iterator(fs::path(CLOTHLAB_TEST_SCENES) / "bad")) {
     if (entry.path().extension() == ".toml") ++files;
   }
-  CHECK(files == 31);
+  CHECK(files == 34);
 }
 
 TEST_CASE("scene error: a missing file") {

@@ -1,0 +1,175 @@
+// Plasticity and tearing (lesson 06): what must hold for any scene.
+#include <doctest/doctest.h>
+
+#include <algorithm>
+#include <cstring>
+#include <set>
+#include <string>
+
+#include "clothlab/aerodynamics.hpp"
+#include "clothlab/plasticity.hpp"
+#include "clothlab/scene.hpp"
+#include "clothlab/spring_damper.hpp"
+#include "clothlab/tearing.hpp"
+
+using clothlab::Index;
+
+namespace {
+
+// A sheet hanging from its top edge in a storm: it stretches, yields and tears.
+std::string storm(const std::string& extra) {
+  return R"(
+[cloth]
+rows = 12
+cols = 12
+spacing = 0.05
+mass = 0.15
+pins = "top-edge"
+[springs]
+ks = 40
+kd = 0.02
+[gravity]
+[aerodynamics]
+wind = [0, 0, 30]
+[integrator]
+dt = 0.0002
+duration = 1.5
+)" + extra;
+}
+
+clothlab::SpringDampers& springs_of(clothlab::World& world) {
+  for (auto& e : world.force_effects) {
+    if (e->name() == "springs") return dynamic_cast<clothlab::SpringDampers&>(*e);
+  }
+  throw std::logic_error("no springs");
+}
+
+std::set<std::pair<Index, Index>> ends_of(const clothlab::SpringSet& s) {
+  std::set<std::pair<Index, Index>> ends;
+  for (size_t k = 0; k < s.size(); ++k)
+    ends.insert({std::min(s.i[k], s.j[k]), std::max(s.i[k], s.j[k])});
+  return ends;
+}
+
+}  // namespace
+
+TEST_CASE("plasticity: rest lengths stay positive and never pass the current length") {
+  clothlab::Scene scene = clothlab::parse_scene(
+      storm("[plasticity]\nyield_strain = 0.05\nmax_strain = 0.5\n"), "p.toml");
+  clothlab::SpringSet& s = springs_of(scene.world).springs();
+  for (long step = 0; step < scene.step_count(); ++step) {
+    scene.world.step(scene.dt);
+    bool positive = true, finite = true, within = true;
+    for (size_t k = 0; k < s.size(); ++k) {
+      positive = positive && s.l0[k] > 0.0;
+      finite = finite && std::isfinite(s.l0[k]);
+      within = within && s.l0[k] <= s.l_built[k] * 1.5 * (1 + 1e-12) &&
+               s.l0[k] >= s.l_built[k] * 0.5 * (1 - 1e-12);
+    }
+    CAPTURE(step);
+    REQUIRE(positive);
+    REQUIRE(finite);
+    REQUIRE(within);  // max_strain = 0.5 around the built length
+  }
+  // It did yield: some rest lengths grew.
+  size_t grown = 0;
+  for (size_t k = 0; k < s.size(); ++k)
+    grown += s.l0[k] > s.l_built[k] * 1.01;
+  CHECK(grown > 0);
+}
+
+TEST_CASE("plasticity: plastic flow never adds energy to a spring") {
+  // Apply only the plastic update to a stretched state and compare the springs' energy.
+  clothlab::Scene scene =
+      clothlab::parse_scene(storm("[plasticity]\nyield_strain = 0.02\n"), "p.toml");
+  for (int step = 0; step < 2000; ++step)
+    scene.world.step(scene.dt);  // the storm stretches it
+  clothlab::SpringDampers& springs = springs_of(scene.world);
+  const double before = springs.potential_energy(scene.world.particles, scene.world.particles.x);
+  clothlab::Plasticity plasticity({0.02, 1e9, 0.9});  // flow all the way at once
+  plasticity.apply(scene.world, scene.dt);
+  const double after = springs.potential_energy(scene.world.particles, scene.world.particles.x);
+  CHECK(after <= before);
+  CHECK(after < before);  // and it did flow
+}
+
+TEST_CASE("plasticity: below the elastic limit nothing changes") {
+  // A breeze instead of the storm: the sheet stretches by a few percent, far below 50 %.
+  std::string breeze = storm("[plasticity]\nyield_strain = 0.5\n");
+  breeze.replace(breeze.find("wind = [0, 0, 30]"), 17, "wind = [0, 0, 2]");
+  clothlab::Scene scene = clothlab::parse_scene(breeze, "p.toml");
+  const clothlab::SpringSet& s = springs_of(scene.world).springs();
+  for (int step = 0; step < 2000; ++step)
+    scene.world.step(scene.dt);
+  CHECK(std::memcmp(s.l0.data(), s.l_built.data(), s.size() * sizeof(double)) == 0);
+}
+
+TEST_CASE("tearing: springs only go, no index dangles, and torn triangles leave the air") {
+  clothlab::Scene scene = clothlab::parse_scene(storm("[tearing]\nstrain = 0.25\n"), "t.toml");
+  clothlab::SpringSet& s = springs_of(scene.world).springs();
+  const size_t springs_at_start = s.size();
+  const Index n = scene.world.particles.size();
+  size_t previous = s.size();
+  for (long step = 0; step < scene.step_count(); ++step) {
+    scene.world.step(scene.dt);
+    REQUIRE(s.size() <= previous);
+    previous = s.size();
+  }
+  CHECK(s.size() < springs_at_start);  // it tore
+  for (size_t k = 0; k < s.size(); ++k) {
+    CHECK(s.i[k] < n);
+    CHECK(s.j[k] < n);
+  }
+  // Every remaining triangle keeps all three of its edges as springs (structural or shear).
+  const auto ends = ends_of(s);
+  const clothlab::Aerodynamics* aero = nullptr;
+  for (const auto& e : scene.world.force_effects) {
+    if (auto* a = dynamic_cast<const clothlab::Aerodynamics*>(e.get())) aero = a;
+  }
+  REQUIRE(aero != nullptr);
+  CHECK(aero->triangles() == scene.world.triangles);
+  CHECK(scene.world.triangles.size() < 2u * 11u * 11u);
+  for (const auto& t : scene.world.triangles) {
+    for (int a = 0; a < 3; ++a) {
+      const Index p = t[a], q = t[(a + 1) % 3];
+      CHECK(ends.count({std::min(p, q), std::max(p, q)}) == 1);
+    }
+  }
+}
+
+TEST_CASE("tearing: which springs tear does not depend on their order in the list") {
+  // Two copies of the same stretched state, one with its spring list reversed: one tearing pass
+  // must remove the same springs (by their end particles) from both.
+  for (size_t max_tears : {size_t{0}, size_t{3}}) {
+    CAPTURE(max_tears);
+    clothlab::Scene a = clothlab::parse_scene(storm(""), "a.toml");
+    for (int step = 0; step < 3000; ++step)
+      a.world.step(a.dt);
+    clothlab::Scene b = clothlab::parse_scene(storm(""), "b.toml");
+    b.world.particles = a.world.particles;
+    clothlab::SpringSet& sb = springs_of(b.world).springs();
+    for (auto* column : {&sb.ks, &sb.kd, &sb.l0, &sb.l_built})
+      std::reverse(column->begin(), column->end());
+    std::reverse(sb.i.begin(), sb.i.end());
+    std::reverse(sb.j.begin(), sb.j.end());
+    clothlab::Tearing ta(0.05, max_tears), tb(0.05, max_tears);
+    ta.apply(a.world, a.dt);
+    tb.apply(b.world, b.dt);
+    CHECK(ta.torn() > 0);
+    CHECK(ta.torn() == tb.torn());
+    CHECK(ends_of(springs_of(a.world).springs()) == ends_of(sb));
+  }
+}
+
+TEST_CASE("tearing: a repeated run is bitwise identical") {
+  clothlab::Scene a = clothlab::parse_scene(storm("[tearing]\nstrain = 0.25\n"), "t.toml");
+  clothlab::Scene b = clothlab::parse_scene(storm("[tearing]\nstrain = 0.25\n"), "t.toml");
+  for (long step = 0; step < a.step_count(); ++step) {
+    a.world.step(a.dt);
+    b.world.step(b.dt);
+  }
+  const auto& xa = a.world.particles.x;
+  const auto& xb = b.world.particles.x;
+  CHECK(std::memcmp(xa.data(), xb.data(), sizeof(double) * static_cast<size_t>(xa.size())) == 0);
+  CHECK(springs_of(a.world).springs().size() == springs_of(b.world).springs().size());
+}
