@@ -53,15 +53,24 @@ void ViewerRecorder::offer(const World& world) {
   if (offered_++ % stride_ != 0) return;
   const Matrix3X& x = world.particles.x;
   positions_.emplace_back(x.data(), x.data() + x.size());  // doubles -> floats
+  if (surfaces_.empty() || surfaces_.back().second.size() != world.triangles.size()) {
+    surfaces_.emplace_back(static_cast<long>(times_.size()), world.triangles);
+  }
   times_.push_back(world.t);
   kinetic_.push_back(world.kinetic_energy());
   potential_.push_back(world.potential_energy());
 }
 
 void ViewerRecorder::write(const World& world, const std::filesystem::path& html) const {
-  std::vector<Index> triangles;
-  for (const Triangle& t : world.triangles)
-    triangles.insert(triangles.end(), t.begin(), t.end());
+  // Each surface as {"from": first frame, "triangles": [i, j, k, ...]}.
+  std::string surfaces;
+  for (const auto& [from, list] : surfaces_) {
+    std::vector<Index> flat;
+    for (const Triangle& t : list)
+      flat.insert(flat.end(), t.begin(), t.end());
+    if (!surfaces.empty()) surfaces += ",";
+    surfaces += fmt::format("{{\"from\":{},\"triangles\":{}}}", from, json_array(flat));
+  }
   std::vector<Index> springs;
   for (const auto& effect : world.force_effects) {
     if (const auto* s = dynamic_cast<const SpringDampers*>(effect.get())) {
@@ -100,11 +109,12 @@ void ViewerRecorder::write(const World& world, const std::filesystem::path& html
   frames += "]";
   const std::string json = fmt::format(
       "{{\"title\":{},\"source\":{},\"particles\":{},\"times\":{},\"kinetic\":{},"
-      "\"potential\":{},\"total\":{},\"triangles\":{},\"springs\":{},\"pins\":{},\"colliders\":[{}]"
+      "\"potential\":{},\"total\":{},\"surfaces\":[{}],\"springs\":{},\"pins\":{},\"colliders\":[{}"
+      "]"
       ","
       "\"frames\":{}}}",
       json_string(title_), json_string(source_), world.particles.size(), json_array(times_),
-      json_array(kinetic_), json_array(potential_), json_array(total), json_array(triangles),
+      json_array(kinetic_), json_array(potential_), json_array(total), surfaces,
       json_array(springs), json_array(pins), colliders, frames);
 
   const std::string_view marker = "/*CLOTHLAB_DATA*/";

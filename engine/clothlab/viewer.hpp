@@ -7,6 +7,7 @@
 
 #include <filesystem>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "clothlab/world.hpp"
@@ -35,6 +36,8 @@ class ViewerRecorder {
   long offered_ = 0;  // frames offered so far
   std::vector<std::vector<float>> positions_;
   std::vector<double> times_, kinetic_, potential_;
+  // The cloth's surface as it was from a frame on: a tear (lesson 06) changes it mid-run.
+  std::vector<std::pair<long, std::vector<Triangle>>> surfaces_;
 };
 
 }  // namespace clothlab
