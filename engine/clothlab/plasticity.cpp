@@ -5,13 +5,6 @@
 
 namespace clothlab {
 
-SpringDampers* find_spring_effect(World& world, std::string_view name) {
-  for (auto& effect : world.force_effects) {
-    if (effect->name() == name) return dynamic_cast<SpringDampers*>(effect.get());
-  }
-  return nullptr;
-}
-
 void Plasticity::apply(World& world, double dt) {
   SpringDampers* springs = find_spring_effect(world, "springs");
   if (!springs) return;

@@ -1,5 +1,7 @@
 #include "clothlab/spring_damper.hpp"
 
+#include "clothlab/world.hpp"
+
 namespace clothlab {
 
 void SpringSet::add(Index a, Index b, double ks_ab, double kd_ab, double l0_ab, const Matrix3X& x) {
@@ -37,6 +39,13 @@ void add_spring_family(SpringSet& springs, const std::vector<std::pair<Index, In
                        Index first, double ks, double kd, const Matrix3X& x) {
   for (const auto& [a, b] : pairs)
     springs.add(first + a, first + b, ks, kd, -1.0, x);
+}
+
+SpringDampers* find_spring_effect(World& world, std::string_view name) {
+  for (auto& effect : world.force_effects) {
+    if (effect->name() == name) return dynamic_cast<SpringDampers*>(effect.get());
+  }
+  return nullptr;
 }
 
 void SpringDampers::add_forces(const Particles& /*p*/, const Matrix3X& x, const Matrix3X& v,

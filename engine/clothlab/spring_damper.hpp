@@ -21,6 +21,8 @@
 
 namespace clothlab {
 
+class SpringDampers;
+
 // Exercise 2.1: the force [N] a spring-damper exerts on particle 1 (the force on particle 2 is
 // its negative), for positions r1, r2 [m], velocities v1, v2 [m/s], spring constant ks [N/m],
 // damping factor kd [N s/m] and rest length l0 [m]. Coincident particles (l = 0) have no
@@ -45,6 +47,9 @@ struct SpringSet {
   // Removes the springs at the given positions (ascending), keeping the others in order.
   void erase(const std::vector<size_t>& positions);
 };
+
+// The spring effect of `world` called `name` ("springs" or "bending"), or nullptr.
+SpringDampers* find_spring_effect(World& world, std::string_view name);
 
 // Appends one spring per pair (a, b), joining particles first + a and first + b, with rest
 // lengths measured in x (the distance at build time).

@@ -9,8 +9,6 @@
 
 namespace clothlab {
 
-SpringDampers* find_spring_effect(World& world, std::string_view name);  // plasticity.cpp
-
 void Tearing::apply(World& world, double /*dt*/) {
   SpringDampers* effect = find_spring_effect(world, "springs");
   if (!effect) return;
@@ -22,8 +20,12 @@ void Tearing::apply(World& world, double /*dt*/) {
     strain[k] = (x.col(s.j[k]) - x.col(s.i[k])).norm() / s.l0[k] - 1.0;
     ends[k] = {std::min(s.i[k], s.j[k]), std::max(s.i[k], s.j[k])};
   }
-  const std::vector<size_t> torn = select_tears(strain, ends, tear_strain_, max_tears_);
+  std::vector<size_t> torn = select_tears(strain, ends, tear_strain_, max_tears_);
   if (torn.empty()) return;
+  // The exercise returns them ascending and once each; make sure of it, so that a slip there
+  // cannot leave a chosen spring in the cloth while its triangles go.
+  std::sort(torn.begin(), torn.end());
+  torn.erase(std::unique(torn.begin(), torn.end()), torn.end());
 
   // The torn edges, then every triangle that had one of them as a side.
   std::set<std::pair<Index, Index>> gone;
