@@ -17,6 +17,7 @@ PICTURES = {
     "03-aerodynamics": ("flag.toml", 200),
     "04-bending-springs": ("drape-stiff.toml", -1),
     "05-ground-collision": ("cloth-on-sphere.toml", -1),
+    "06-plasticity-and-tearing": ("storm-flag.toml", 25),
 }
 
 
