@@ -2,7 +2,7 @@
 //
 // Lecture, "Physics Simulation": 1. compute forces, 2. integrate motion, repeat.
 // A ForceEffect takes part in step 1 (gravity, springs, wind, ...). A PostStepEffect runs
-// once after the integrator has moved the particles (pins, collisions, plasticity, tearing).
+// once after the integrator has moved the particles (collisions, plasticity, tearing).
 // A scene constructs only the effects it names: an effect it does not name is never built,
 // so it costs nothing at all. The virtual call happens once per effect per force evaluation,
 // never once per particle.

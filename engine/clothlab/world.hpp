@@ -4,7 +4,7 @@
 //   1. clear the force accumulators;
 //   2. every force effect adds its forces;
 //   3. the integrator advances positions and velocities (re-evaluating 1-2 if it needs to);
-//   4. every post-step effect applies (pins, collisions, ...);
+//   4. every post-step effect applies (collisions, plasticity, tearing);
 //   5. the guard checks that the state is still finite and bounded.
 #pragma once
 
