@@ -5,17 +5,12 @@
 
 #include <fmt/format.h>
 
+#include "clothlab/output.hpp"
 #include "clothlab/spring_damper.hpp"
 
 namespace clothlab {
 
 namespace {
-
-std::ofstream open(const std::filesystem::path& path) {
-  std::ofstream out(path, std::ios::trunc);
-  if (!out) throw std::runtime_error(fmt::format("cannot write {}", path.string()));
-  return out;
-}
 
 // Every spring of the world's spring effects, as (i, j, l0).
 struct SpringView {
@@ -60,7 +55,7 @@ void MeshExporter::write(const World& world, long frame) {
   const std::string stem = fmt::format("frame_{:04}", frame);
   const std::vector<SpringView> springs = all_springs(world);
   if (obj_) {
-    std::ofstream out = open(dir_ / (stem + ".obj"));
+    std::ofstream out = open_for_writing(dir_ / (stem + ".obj"));
     out << fmt::format("# clothlab frame {} at t = {} s\n", frame, world.t);
     for (Index i = 0; i < x.cols(); ++i) {
       out << fmt::format("v {} {} {}\n", x(0, i), x(1, i), x(2, i));
@@ -82,7 +77,7 @@ void MeshExporter::write(const World& world, long frame) {
   }
   if (vtk_) {
     const std::string name = stem + ".vtk";
-    std::ofstream out = open(dir_ / name);
+    std::ofstream out = open_for_writing(dir_ / name);
     const Matrix3X& v = world.particles.v;
     out << "# vtk DataFile Version 3.0\n"
         << fmt::format("clothlab frame {} t = {}\n", frame, world.t) << "ASCII\nDATASET POLYDATA\n"
@@ -115,7 +110,7 @@ void MeshExporter::write(const World& world, long frame) {
 
 void MeshExporter::finish() const {
   if (!vtk_) return;
-  std::ofstream out = open(dir_ / "frames.vtk.series");
+  std::ofstream out = open_for_writing(dir_ / "frames.vtk.series");
   out << "{\n  \"file-series-version\": \"1.0\",\n  \"files\": [\n";
   for (size_t k = 0; k < vtk_files_.size(); ++k) {
     out << fmt::format("    {{\"name\": \"{}\", \"time\": {}}}{}\n", vtk_files_[k].first,

@@ -5,15 +5,11 @@
 
 namespace clothlab {
 
-namespace {
-
 std::ofstream open_for_writing(const std::filesystem::path& path) {
   std::ofstream out(path, std::ios::trunc);
   if (!out) throw std::runtime_error(fmt::format("cannot write {}", path.string()));
   return out;
 }
-
-}  // namespace
 
 FrameWriter::FrameWriter(const std::filesystem::path& dir) {
   std::filesystem::create_directories(dir);

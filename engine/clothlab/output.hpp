@@ -16,6 +16,9 @@
 
 namespace clothlab {
 
+// Opens `path` for writing, replacing what was there; throws if it cannot.
+std::ofstream open_for_writing(const std::filesystem::path& path);
+
 class FrameWriter {
  public:
   // Creates `dir` if needed and opens the files, replacing those of an earlier run.
