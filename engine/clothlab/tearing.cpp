@@ -46,6 +46,20 @@ void Tearing::apply(World& world, double /*dt*/) {
       aero->remove_triangles_if(has_torn_edge);
     }
   }
+  // A bending spring (a, c) spans the particle m = (a + c) / 2 between them (two apart along a
+  // row, a column or a rope). Once either half, (a, m) or (m, c), has torn, it would hold the
+  // two sides of the tear together: it goes too.
+  if (SpringDampers* bending = find_spring_effect(world, "bending")) {
+    SpringSet& b = bending->springs();
+    std::vector<size_t> spanning;
+    for (size_t k = 0; k < b.size(); ++k) {
+      const Index a = std::min(b.i[k], b.j[k]), c = std::max(b.i[k], b.j[k]);
+      if ((a + c) % 2 != 0) continue;
+      const Index m = (a + c) / 2;
+      if (gone.count({a, m}) != 0 || gone.count({m, c}) != 0) spanning.push_back(k);
+    }
+    b.erase(spanning);
+  }
 }
 
 }  // namespace clothlab

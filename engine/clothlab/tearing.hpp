@@ -1,7 +1,8 @@
 // tearing.hpp: springs that break when stretched too far, and the cloth that tears with them.
 //
 // Lecture: past a second, larger limit a spring breaks: it is removed for good. A triangle that
-// loses one of its edges is removed too, so the air stops pushing on a hole. Which springs break
+// loses one of its edges is removed too, so the air stops pushing on a hole, and so is a bending
+// spring that reached across the torn spring. Which springs break
 // in a step must not depend on the order they are stored in: otherwise the same cloth would
 // tear differently after an unrelated change to how it was built. So the choice is made on the
 // springs' strains and their end particles only (exercise 6.2), and applied all at once.

@@ -173,3 +173,23 @@ TEST_CASE("tearing: a repeated run is bitwise identical") {
   CHECK(std::memcmp(xa.data(), xb.data(), sizeof(double) * static_cast<size_t>(xa.size())) == 0);
   CHECK(springs_of(a.world).springs().size() == springs_of(b.world).springs().size());
 }
+
+TEST_CASE("tearing: bending springs that reach across a tear go with it") {
+  // With [bending], every bending spring left must still have both of its halves as springs:
+  // otherwise it would hold the two sides of a tear together.
+  clothlab::Scene scene =
+      clothlab::parse_scene(storm("[bending]\nks = 2\n[tearing]\nstrain = 0.25\n"), "b.toml");
+  for (long step = 0; step < scene.step_count(); ++step)
+    scene.world.step(scene.dt);
+  const auto ends = ends_of(springs_of(scene.world).springs());
+  const clothlab::SpringDampers* bending = clothlab::find_spring_effect(scene.world, "bending");
+  REQUIRE(bending != nullptr);
+  const clothlab::SpringSet& b = bending->springs();
+  CHECK(b.size() < 2u * 12u * 10u);  // some went
+  for (size_t k = 0; k < b.size(); ++k) {
+    const Index a = std::min(b.i[k], b.j[k]), c = std::max(b.i[k], b.j[k]);
+    const Index m = (a + c) / 2;
+    CHECK(ends.count({a, m}) == 1);
+    CHECK(ends.count({m, c}) == 1);
+  }
+}
