@@ -23,6 +23,7 @@
 #include "app/build_info.hpp"
 #include "app/demo_scene.hpp"
 #include "app/grade.hpp"
+#include "clothlab/implicit_euler.hpp"
 #include "clothlab/not_implemented.hpp"
 #include "clothlab/run.hpp"
 #include "clothlab/scene.hpp"
@@ -90,6 +91,28 @@ void print_stats(const World& world, const StepTimes& times) {
   }
   row(fmt::format("{} (own)", world.integrator->name()), times.integrator);
   row("guard", times.guard);
+  fmt::print("  force evaluations: {} ({} per step)\n", world.force_evaluations,
+             world.integrator->force_evaluations_per_step());
+  if (const auto* implicit = dynamic_cast<const ImplicitEuler*>(world.integrator.get())) {
+    const LinearSolveStats& s = implicit->stats();
+    fmt::print(
+        "  linear solves: {}, conjugate-gradient iterations {:.1f} per solve (most {}), "
+        "largest relative residual {:.2g}\n",
+        s.solves, s.solves > 0 ? static_cast<double>(s.iterations) / s.solves : 0.0,
+        s.max_iterations, s.worst_error);
+  }
+}
+
+// After a run with the implicit integrator: say so if some linear solves stopped early.
+void warn_unconverged(const World& world) {
+  const auto* implicit = dynamic_cast<const ImplicitEuler*>(world.integrator.get());
+  if (!implicit || implicit->stats().unconverged == 0) return;
+  const LinearSolveStats& s = implicit->stats();
+  fmt::print(stderr,
+             "warning: {} of {} linear solves stopped at max_iterations = {} with a relative "
+             "residual up to {:.2g} (tolerance {:.2g}); raise max_iterations in [integrator] or "
+             "take a smaller dt\n",
+             s.unconverged, s.solves, implicit->max_iterations, s.worst_error, implicit->tolerance);
 }
 
 int run(Scene& scene, const RunOutputs& outputs, bool stats) {
@@ -117,6 +140,7 @@ int run(Scene& scene, const RunOutputs& outputs, bool stats) {
       fmt::print("  watch it: open {} in a browser\n", outputs.html.string());
     }
     if (stats) print_stats(scene.world, times);
+    warn_unconverged(scene.world);
     return 0;
   } catch (const SimulationError& error) {
     std::fflush(stdout);  // what was said before the error comes before it

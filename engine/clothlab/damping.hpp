@@ -18,6 +18,9 @@ class Damping final : public ForceEffect {
   std::string_view name() const override { return "damping"; }
   void add_forces(const Particles& p, const Matrix3X& x, const Matrix3X& v,
                   Matrix3X& f) const override;
+  // df_i/dv_i = -rate m_i I.
+  bool add_jacobians(const Particles& p, const Matrix3X& x, const Matrix3X& v,
+                     ForceJacobians& jacobians) const override;
 
  private:
   double rate_;  // damping rate [1/s]

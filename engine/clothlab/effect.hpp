@@ -16,6 +16,24 @@ namespace clothlab {
 
 class World;
 
+using Mat3 = Eigen::Matrix3d;
+
+// Where an effect writes its force Jacobians for the implicit integrator (lesson 07): how its
+// forces change when positions (df/dx) and velocities (df/dv) change, as 3x3 blocks.
+class ForceJacobians {
+ public:
+  virtual ~ForceJacobians() = default;
+
+  // A force between i and j that is equal and opposite and depends on the differences
+  // x_j - x_i and v_j - v_i (a spring-damper). dfdx = df_i/dx_j and dfdv = df_i/dv_j, both
+  // symmetric; the other three blocks follow: df_i/dx_i = -dfdx, df_j/dx_i = dfdx,
+  // df_j/dx_j = -dfdx, and the same for dfdv.
+  virtual void add_pair(Index i, Index j, const Mat3& dfdx, const Mat3& dfdv) = 0;
+
+  // A force on particle i alone: dfdx = df_i/dx_i and dfdv = df_i/dv_i, both symmetric.
+  virtual void add_self(Index i, const Mat3& dfdx, const Mat3& dfdv) = 0;
+};
+
 class ForceEffect {
  public:
   virtual ~ForceEffect() = default;
@@ -32,6 +50,14 @@ class ForceEffect {
   // The potential energy this effect stores at positions x [J]; 0 for forces without one.
   virtual double potential_energy(const Particles& /*p*/, const Matrix3X& /*x*/) const {
     return 0.0;
+  }
+
+  // Adds this effect's force Jacobians at (x, v) for the implicit integrator. An effect that
+  // adds none (gravity, wind) is treated explicitly: its force enters the step, its Jacobian
+  // does not. Returns whether it added any.
+  virtual bool add_jacobians(const Particles& /*p*/, const Matrix3X& /*x*/, const Matrix3X& /*v*/,
+                             ForceJacobians& /*jacobians*/) const {
+    return false;
   }
 };
 

@@ -21,11 +21,11 @@ void euler_advance(World& world, double dt, Kernel kernel) {
 
 }  // namespace
 
-void ExplicitEuler::advance(World& world, double dt) const {
+void ExplicitEuler::advance(World& world, double dt) {
   euler_advance(world, dt, explicit_euler_step);
 }
 
-void SymplecticEuler::advance(World& world, double dt) const {
+void SymplecticEuler::advance(World& world, double dt) {
   euler_advance(world, dt, symplectic_euler_step);
 }
 

@@ -35,13 +35,15 @@ PointState symplectic_euler_step(const Vec3& r, const Vec3& v, const Vec3& f, do
 class ExplicitEuler final : public Integrator {
  public:
   std::string_view name() const override { return "explicit-euler"; }
-  void advance(World& world, double dt) const override;
+  void advance(World& world, double dt) override;
+  int force_evaluations_per_step() const override { return 1; }
 };
 
 class SymplecticEuler final : public Integrator {
  public:
   std::string_view name() const override { return "symplectic-euler"; }
-  void advance(World& world, double dt) const override;
+  void advance(World& world, double dt) override;
+  int force_evaluations_per_step() const override { return 1; }
 };
 
 }  // namespace clothlab

@@ -3,12 +3,17 @@
 #include <array>
 
 #include "clothlab/euler.hpp"
+#include "clothlab/implicit_euler.hpp"
+#include "clothlab/runge_kutta.hpp"
+#include "clothlab/verlet.hpp"
 
 namespace clothlab {
 
 namespace {
-// Every integrator a scene may name; a later lesson adds its methods here.
-constexpr std::array<std::string_view, 2> kNames = {"explicit-euler", "symplectic-euler"};
+// Every integrator a scene may name, from lesson 01's Euler methods to lesson 07's.
+constexpr std::array<std::string_view, 7> kNames = {
+    "explicit-euler",  "symplectic-euler", "midpoint",      "rk4",
+    "velocity-verlet", "position-verlet",  "implicit-euler"};
 }  // namespace
 
 std::span<const std::string_view> integrator_names() {
@@ -18,6 +23,11 @@ std::span<const std::string_view> integrator_names() {
 std::unique_ptr<Integrator> make_integrator(std::string_view name) {
   if (name == "explicit-euler") return std::make_unique<ExplicitEuler>();
   if (name == "symplectic-euler") return std::make_unique<SymplecticEuler>();
+  if (name == "midpoint") return std::make_unique<Midpoint>();
+  if (name == "rk4") return std::make_unique<RungeKutta4>();
+  if (name == "velocity-verlet") return std::make_unique<VelocityVerlet>();
+  if (name == "position-verlet") return std::make_unique<PositionVerlet>();
+  if (name == "implicit-euler") return std::make_unique<ImplicitEuler>();
   return nullptr;
 }
 

@@ -2,7 +2,9 @@
 //
 // An integrator asks the world for forces (as often as its method needs: once for Euler,
 // several times for multi-stage methods) and moves positions and velocities forward by dt.
-// Each method lives in its own file (euler.cpp, ...) and is chosen by name in the scene.
+// Each method lives in its own file (euler.cpp, runge_kutta.cpp, verlet.cpp, implicit_euler.cpp)
+// and is chosen by name in the scene. An integrator may keep state between steps (buffers, the
+// previous positions of position Verlet), so each world owns its own.
 #pragma once
 
 #include <memory>
@@ -19,7 +21,11 @@ class Integrator {
   virtual std::string_view name() const = 0;
 
   // Advances world.particles by dt [s]. Evaluates forces through world.compute_forces.
-  virtual void advance(World& world, double dt) const = 0;
+  virtual void advance(World& world, double dt) = 0;
+
+  // Force evaluations per step, for reports ("4" for RK4). The implicit integrator also solves
+  // a linear system; its cost is in its own statistics.
+  virtual int force_evaluations_per_step() const = 0;
 };
 
 // The names a scene may give in [integrator] method = "...".

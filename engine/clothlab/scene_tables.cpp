@@ -11,6 +11,7 @@
 #include "clothlab/gravitation.hpp"
 #include "clothlab/gravity.hpp"
 #include "clothlab/ground_collision.hpp"
+#include "clothlab/implicit_euler.hpp"
 #include "clothlab/plasticity.hpp"
 #include "clothlab/tearing.hpp"
 
@@ -282,7 +283,21 @@ void read_tearing(SceneTable& t, Scene& scene) {
 // [integrator]: the method, the time step and how long to simulate.
 void read_integrator(SceneTable& t, Scene& scene) {
   const std::vector<std::string_view> names(integrator_names().begin(), integrator_names().end());
-  scene.world.integrator = make_integrator(t.choice("method", names, "symplectic-euler"));
+  const std::string method = t.choice("method", names, "symplectic-euler");
+  scene.world.integrator = make_integrator(method);
+  // The linear solver of the implicit method; another method has none to tune.
+  for (const char* key : {"tolerance", "max_iterations"}) {
+    if (method != "implicit-euler" && t.has(key)) {
+      t.fail(key, fmt::format("{} tunes the linear solver of method = \"implicit-euler\", but "
+                              "method is \"{}\"; expected no {} here",
+                              key, method, key));
+    }
+  }
+  if (auto* implicit = dynamic_cast<ImplicitEuler*>(scene.world.integrator.get())) {
+    implicit->tolerance = t.number("tolerance", Range{0.0, 1.0, true, ""}, implicit->tolerance);
+    implicit->max_iterations =
+        static_cast<int>(t.integer("max_iterations", 1, 1'000'000, implicit->max_iterations));
+  }
   scene.dt = t.required_number("dt", Range::positive("s"));
   scene.duration = t.required_number("duration", Range::positive("s"));
   if (scene.dt > scene.duration) {
@@ -332,7 +347,7 @@ constexpr std::array kKinds = {
                    "[plasticity] with yield_strain", read_plasticity},
     SceneTableKind{"tearing", false, false, "strain max_per_step", "[tearing] with strain",
                    read_tearing},
-    SceneTableKind{"integrator", false, true, "method dt duration",
+    SceneTableKind{"integrator", false, true, "method dt duration tolerance max_iterations",
                    "[integrator] with method, dt [s] and duration [s]", read_integrator},
     SceneTableKind{"output", false, false, "fps", "[output] with fps", read_output},
     SceneTableKind{"guard", false, false, "max_position max_speed",

@@ -1,5 +1,7 @@
 #include "clothlab/spring_damper.hpp"
 
+#include <algorithm>
+
 #include "clothlab/world.hpp"
 
 namespace clothlab {
@@ -67,6 +69,28 @@ double SpringDampers::potential_energy(const Particles& /*p*/, const Matrix3X& x
     energy += spring_energy(x.col(s.i[k]), x.col(s.j[k]), s.ks[k], s.l0[k]);
   }
   return energy;
+}
+
+SpringJacobian spring_damper_jacobian(const Vec3& r1, const Vec3& r2, double ks, double kd,
+                                      double l0) {
+  const Vec3 d = r2 - r1;
+  const double l = d.norm();
+  if (l == 0.0) return {Mat3::Zero(), Mat3::Zero()};  // no direction: no force, no Jacobian
+  const Vec3 e = d / l;
+  const Mat3 along = e * e.transpose();  // projects onto the spring's direction
+  const double across = std::max(0.0, 1.0 - l0 / l);
+  return {ks * (along + across * (Mat3::Identity() - along)), kd * along};
+}
+
+bool SpringDampers::add_jacobians(const Particles& /*p*/, const Matrix3X& x, const Matrix3X& /*v*/,
+                                  ForceJacobians& jacobians) const {
+  const SpringSet& s = springs_;
+  for (size_t k = 0; k < s.size(); ++k) {
+    const SpringJacobian jac =
+        spring_damper_jacobian(x.col(s.i[k]), x.col(s.j[k]), s.ks[k], s.kd[k], s.l0[k]);
+    jacobians.add_pair(s.i[k], s.j[k], jac.dfdx, jac.dfdv);
+  }
+  return true;
 }
 
 }  // namespace clothlab

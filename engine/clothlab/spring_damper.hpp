@@ -23,6 +23,21 @@ namespace clothlab {
 
 class SpringDampers;
 
+// How the spring-damper force on particle 1 changes as particle 2 moves (df1/dr2) and as its
+// velocity changes (df1/dv2), for the implicit integrator:
+//   df1/dr2 = ks [ e e^T + max(0, 1 - l0/l) (I - e e^T) ],   df1/dv2 = kd e e^T.
+// Along the spring the stiffness is ks; across it, a stretched spring resists turning with
+// ks (1 - l0/l). A compressed spring would give a negative stiffness across it, which makes
+// the implicit system indefinite; like most cloth codes we drop that term (the max), so the
+// system stays symmetric positive definite and conjugate gradients can solve it. The damping
+// force's change with position is small and dropped as well (Baraff and Witkin do the same).
+struct SpringJacobian {
+  Mat3 dfdx;
+  Mat3 dfdv;
+};
+SpringJacobian spring_damper_jacobian(const Vec3& r1, const Vec3& r2, double ks, double kd,
+                                      double l0);
+
 // Exercise 2.1: the force [N] a spring-damper exerts on particle 1 (the force on particle 2 is
 // its negative), for positions r1, r2 [m], velocities v1, v2 [m/s], spring constant ks [N/m],
 // damping factor kd [N s/m] and rest length l0 [m]. Coincident particles (l = 0) have no
@@ -66,6 +81,8 @@ class SpringDampers final : public ForceEffect {
   void add_forces(const Particles& p, const Matrix3X& x, const Matrix3X& v,
                   Matrix3X& f) const override;
   double potential_energy(const Particles& p, const Matrix3X& x) const override;
+  bool add_jacobians(const Particles& p, const Matrix3X& x, const Matrix3X& v,
+                     ForceJacobians& jacobians) const override;
   const SpringSet& springs() const { return springs_; }
   SpringSet& springs() { return springs_; }
 

@@ -49,6 +49,7 @@ void World::step(double dt) {
 
 void World::compute_forces(const Matrix3X& x, const Matrix3X& v, Matrix3X& f) const {
   f.setZero();
+  ++force_evaluations;
   if (!timing) {
     for (const auto& effect : force_effects)
       effect->add_forces(particles, x, v, f);

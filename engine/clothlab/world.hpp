@@ -41,6 +41,9 @@ class World {
   double t = 0.0;  // simulated time [s]
   long steps = 0;  // steps taken so far
 
+  // How often compute_forces has run: what a multi-stage integrator pays per step.
+  mutable long force_evaluations = 0;
+
   // When set (by `clothlab run --stats`), each step adds the time of each of its parts here.
   // The check costs one branch per effect per evaluation, never one per particle.
   StepTimes* timing = nullptr;
