@@ -1,28 +1,51 @@
-// bench.cpp: `clothlab bench boundary`.
+// bench.cpp: `clothlab bench boundary` and `clothlab bench accuracy`.
 //
+// bench boundary:
 // The engine's hot loops call the exercise kernels (gravity_force, symplectic_euler_step), which
 // live in another file, exercises/ or solutions/. Without help from the compiler every particle
 // would pay for two out-of-line calls and could not be vectorised. Link-time optimisation
 // inlines the kernels across that boundary. This benchmark measures the engine's step against
 // the same passes with the kernels' arithmetic written inline here, in one run, and prints the
 // ratio: close to 1 means the boundary costs nothing.
+//
+// bench accuracy: the work-precision study of lesson 07 (clothlab/accuracy.hpp): every
+// integrator over a ladder of time steps, printed as a table, written as CSV and drawn as a
+// log-log plot by a small matplotlib script written next to the CSV.
 #include "app/bench.hpp"
+
+#include <spawn.h>
+#include <sys/wait.h>
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <map>
 #include <stdexcept>
+#include <string>
 #include <vector>
 
 #include <fmt/format.h>
 
 #include "app/build_info.hpp"
+#include "clothlab/accuracy.hpp"
 #include "clothlab/euler.hpp"
 #include "clothlab/gravity.hpp"
+#include "clothlab/integrator.hpp"
+#include "clothlab/output.hpp"
+#include "clothlab/scene.hpp"
 #include "clothlab/world.hpp"
+
+extern char** environ;
 
 namespace clothlab::app {
 
+extern const std::string_view kPlotAccuracyScript;
+
 namespace {
+
+namespace fs = std::filesystem;
 
 World make_world(Index n) {
   World world;
@@ -109,6 +132,143 @@ void bench_boundary(Index n, long steps, int repeats) {
       t_fused, t_engine / t_fused);
 }
 
+// --- bench accuracy ------------------------------------------------------------------------
+
+struct AccuracyOptions {
+  std::string scene;  // empty: the damped oscillator
+  std::string out = "clothlab-out/accuracy";
+  std::string plot;  // empty: OUT/work-precision.svg
+  bool no_plot = false;
+  std::vector<std::string> integrators;
+  double time = 0.0;  // [s]; 0: the problem's default
+  double zeta = 0.05;
+  double min_seconds = 0.02;  // wall time each run is repeated for
+  bool quick = false;
+};
+
+// "1.23e-04" or "-" for a number that is not one.
+std::string sci(double value) {
+  return std::isfinite(value) ? fmt::format("{:.2e}", value) : "-";
+}
+
+// Runs `python3 script csv out`; returns its exit status (127 when python3 cannot start).
+// Debian's own python3 comes first: that is where `apt-get install python3-matplotlib` puts
+// matplotlib, whatever other python3 comes first on the PATH.
+int run_python(const fs::path& script, const fs::path& csv, const fs::path& out) {
+  std::fflush(stdout);  // what was printed so far comes before the script's output
+  std::string a0 = fs::exists("/usr/bin/python3") ? "/usr/bin/python3" : "python3";
+  std::string a1 = script.string(), a2 = csv.string(), a3 = out.string();
+  char* argv[] = {a0.data(), a1.data(), a2.data(), a3.data(), nullptr};
+  pid_t pid = 0;
+  if (posix_spawnp(&pid, a0.c_str(), nullptr, nullptr, argv, environ) != 0) return 127;
+  int status = 0;
+  waitpid(pid, &status, 0);
+  return WIFEXITED(status) ? WEXITSTATUS(status) : 1;
+}
+
+// The cheapest stable run of each target accuracy: what the study is for.
+void print_cheapest(const std::vector<AccuracyRun>& runs) {
+  fmt::print("\n  cheapest stable run reaching each error (wall time per simulated second):\n");
+  for (double target : {1e-2, 1e-4, 1e-6, 1e-8}) {
+    const AccuracyRun* best = nullptr;
+    for (const AccuracyRun& run : runs) {
+      if (!run.stable || !(run.error <= target)) continue;
+      if (!best || run.wall_per_sim < best->wall_per_sim) best = &run;
+    }
+    if (best) {
+      fmt::print("    error <= {:.0e}: {:<17} dt = {:<9.3g} {} s ({} force evaluations)\n", target,
+                 best->integrator, best->dt, sci(best->wall_per_sim), sci(best->evals_per_sim));
+    } else {
+      fmt::print("    error <= {:.0e}: no run of the ladder reached it\n", target);
+    }
+  }
+}
+
+int bench_accuracy(const AccuracyOptions& opt) {
+  std::vector<std::string> integrators = opt.integrators;
+  if (integrators.empty()) integrators.assign(integrator_names().begin(), integrator_names().end());
+
+  std::unique_ptr<AccuracyProblem> problem;
+  std::vector<double> dts;
+  if (opt.scene.empty()) {
+    const double end = opt.time > 0.0 ? opt.time : 4.0;
+    problem = std::make_unique<DampedOscillatorProblem>(1.0, 100.0, opt.zeta, end);
+    // 0.2 s (y = dt w = 2: past most methods' limits) halving down to about 1e-4 s.
+    const int rungs = opt.quick ? 6 : 12;
+    for (int k = 0; k < rungs; ++k)
+      dts.push_back(0.2 / std::pow(2.0, k));
+  } else {
+    const Scene scene = load_scene_file(opt.scene);
+    const double end = opt.time > 0.0 ? opt.time : std::min(scene.duration, 0.5);
+    // From 8 times the scene's dt down to a quarter of it; the reference at dt / 32.
+    const int rungs = opt.quick ? 3 : 6;
+    for (int k = 0; k < rungs; ++k)
+      dts.push_back(scene.dt * 8.0 / std::pow(2.0, k));
+    fmt::print("bench accuracy: running the RK4 reference of {} ...\n", opt.scene);
+    problem = std::make_unique<SceneProblem>(opt.scene, end, scene.dt / 32.0);
+  }
+  // Every dt must cover the end time in whole steps.
+  for (double dt : dts) {
+    const double steps = problem->end_time() / dt;
+    if (std::abs(steps - std::round(steps)) > 1e-9 * steps) {
+      throw std::invalid_argument(fmt::format("--time {} s is not a whole number of steps of {} s",
+                                              problem->end_time(), dt));
+    }
+  }
+
+  fmt::print("bench accuracy: {}\n", problem->description());
+  fmt::print("  {} integrators x {} time steps, each run repeated for {} s (fastest kept)\n\n",
+             integrators.size(), dts.size(), opt.min_seconds);
+  fmt::print("  {:<17} {:>9} {:>8} {:>9} {:>6} {:>13} {:>13}  {}\n", "integrator", "dt [s]",
+             "steps", "error", "order", "wall s/sim s", "evals/sim s", "stable");
+  const AccuracyRun* previous = nullptr;
+  std::vector<AccuracyRun> runs;
+  runs.reserve(integrators.size() * dts.size());
+  const auto report = [&](const AccuracyRun& run) {
+    runs.push_back(run);
+    const AccuracyRun& here = runs.back();
+    std::string order = "";
+    if (previous && previous->integrator == here.integrator && previous->stable && here.stable) {
+      const double p = observed_order(*previous, here);
+      if (std::isfinite(p)) order = fmt::format("{:.2f}", p);
+    }
+    fmt::print("  {:<17} {:>9.3g} {:>8} {:>9} {:>6} {:>13} {:>13}  {}\n", here.integrator, here.dt,
+               here.steps, sci(here.error), order, sci(here.wall_per_sim), sci(here.evals_per_sim),
+               here.stable ? "yes" : (here.stopped.empty() ? "no" : "no (guard stopped it)"));
+    previous = &runs.back();
+  };
+  run_accuracy_study(*problem, integrators, dts, opt.min_seconds, report);
+  print_cheapest(runs);
+
+  // The CSV, then the plot drawn from it.
+  const fs::path out_dir = opt.out;
+  fs::create_directories(out_dir);
+  const fs::path csv = out_dir / "accuracy.csv";
+  {
+    std::ofstream file = open_for_writing(csv);
+    file << "problem,integrator,dt,steps,error,wall_s_per_sim_s,force_evals_per_sim_s,stable\n";
+    for (const AccuracyRun& run : runs) {
+      file << fmt::format("{},{},{:.17g},{},{:.17g},{:.17g},{:.17g},{}\n", problem->name(),
+                          run.integrator, run.dt, run.steps, run.error, run.wall_per_sim,
+                          run.evals_per_sim, run.stable ? "true" : "false");
+    }
+  }
+  const fs::path script = out_dir / "plot_accuracy.py";
+  open_for_writing(script) << kPlotAccuracyScript;
+  fmt::print("\n  wrote {} and {}\n", csv.string(), script.string());
+  if (opt.no_plot) return 0;
+  const fs::path plot = opt.plot.empty() ? out_dir / "work-precision.svg" : fs::path(opt.plot);
+  const int status = run_python(script, csv, plot);
+  if (status != 0) {
+    fmt::print(stderr,
+               "warning: the plot was not drawn ({}); the CSV is written. To draw it: sudo "
+               "apt-get install -y python3-matplotlib, then python3 {} {} {}\n",
+               status == 127 ? "python3 did not start" : "the plot script failed", script.string(),
+               csv.string(), plot.string());
+  }
+  return 0;
+}
+
 }  // namespace
 
 void add_bench_command(CLI::App& app) {
@@ -124,6 +284,53 @@ void add_bench_command(CLI::App& app) {
   boundary->add_option("--repeats", repeats, "Repeats (median is shown)")
       ->check(CLI::PositiveNumber);
   boundary->callback([] { bench_boundary(n, steps, repeats); });
+
+  static AccuracyOptions accuracy_options;
+  AccuracyOptions& a = accuracy_options;
+  CLI::App* accuracy = bench->add_subcommand(
+      "accuracy",
+      "Work-precision study: every integrator over a ladder of time steps, error against wall "
+      "time (table, CSV and plot)");
+  accuracy
+      ->add_option("scene", a.scene,
+                   "A scene to study (default: a damped oscillator with its exact solution)")
+      ->check(CLI::ExistingFile);
+  accuracy->add_option("--out", a.out, "Directory for accuracy.csv, the plot and its script")
+      ->capture_default_str();
+  accuracy->add_option("--plot", a.plot,
+                       "Plot file (.svg, .png or .pdf; default OUT/work-precision.svg)");
+  accuracy->add_flag("--no-plot", a.no_plot, "Write the CSV and the script, draw nothing");
+  accuracy->add_option("--integrators", a.integrators, "Integrators to compare (default: all)")
+      ->delimiter(',')
+      ->check(CLI::IsMember(
+          std::vector<std::string>(integrator_names().begin(), integrator_names().end())));
+  accuracy
+      ->add_option("--time", a.time,
+                   "End time [s] (default 4 s for the oscillator, min(duration, 0.5 s) for "
+                   "a scene)")
+      ->check(CLI::PositiveNumber);
+  accuracy->add_option("--zeta", a.zeta, "The oscillator's damping ratio (0 <= zeta < 1)")
+      ->check(CLI::Range(0.0, 0.999))
+      ->capture_default_str();
+  accuracy
+      ->add_option("--min-seconds", a.min_seconds,
+                   "Wall time [s] each run is repeated for; the fastest repeat is kept")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
+  accuracy->add_flag("--quick", a.quick, "A shorter ladder of time steps (for tests)");
+  accuracy->callback([] {
+    int status = 0;
+    try {
+      status = bench_accuracy(accuracy_options);
+    } catch (const SceneError& e) {
+      fmt::print(stderr, "error: {}\n", e.what());
+      status = 2;  // a bad scene, as for `clothlab run`
+    } catch (const std::exception& e) {
+      fmt::print(stderr, "error: bench accuracy: {}\n", e.what());
+      status = 1;
+    }
+    if (status != 0) throw CLI::RuntimeError(status);
+  });
 }
 
 }  // namespace clothlab::app
