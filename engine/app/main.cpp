@@ -11,6 +11,7 @@
 #include <unistd.h>
 
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
@@ -27,6 +28,7 @@
 #include "clothlab/not_implemented.hpp"
 #include "clothlab/run.hpp"
 #include "clothlab/scene.hpp"
+#include "clothlab/stability.hpp"
 
 namespace fs = std::filesystem;
 using namespace clothlab;
@@ -124,6 +126,12 @@ int run(Scene& scene, const RunOutputs& outputs, bool stats) {
   fmt::print("  {}; {}; dt = {} s for {} s ({} steps)\n", particle_count(scene),
              scene.world.effects_in_play(), scene.dt, scene.duration, scene.step_count());
   const double energy_start = scene.world.kinetic_energy() + scene.world.potential_energy();
+  // The time-step advisor speaks before the run, so a user who sees it blow up knows why.
+  const TimeStepAdvice advice = advise_time_step(scene.world, scene.dt, scene.step_count());
+  if (!advice.warning.empty()) {
+    std::fflush(stdout);
+    fmt::print(stderr, "warning: {}\n", advice.warning);
+  }
   ProgressBar bar;
   try {
     const RunReport report = run_scene(scene, outputs, std::ref(bar));
@@ -204,6 +212,18 @@ int main(int argc, char** argv) {
       fmt::print("{}: ok: {}; {}; dt = {} s for {} s ({} steps)\n", validate_path,
                  particle_count(scene), scene.world.effects_in_play(), scene.dt, scene.duration,
                  scene.step_count());
+      const TimeStepAdvice advice = advise_time_step(scene.world, scene.dt, scene.step_count());
+      if (advice.bounds.omega_max > 0.0) {
+        fmt::print("  stiffest mode: w <= {:.4g} rad/s; stable time step for {}: {}\n",
+                   advice.bounds.omega_max, scene.world.integrator->name(),
+                   advice.dt_limit == 0.0        ? std::string("none (unstable at every dt)")
+                   : std::isinf(advice.dt_limit) ? std::string("any")
+                                                 : fmt::format("dt <= {:.3g} s", advice.dt_limit));
+      }
+      if (!advice.warning.empty()) {
+        std::fflush(stdout);
+        fmt::print(stderr, "warning: {}\n", advice.warning);
+      }
       return 0;
     }
     if (app.get_subcommands().empty()) {

@@ -1,0 +1,314 @@
+// The time-step advisor (stability.hpp) and the guard's energy-runaway check.
+//
+// The advisor's step matrices are a second, readable copy of each integrator written on one
+// oscillator: the first cases check that they agree with the engine's integrators step for
+// step, so the limits the advisor quotes are the engine's, not a textbook's.
+#include <doctest/doctest.h>
+
+#include <cmath>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <Eigen/Eigenvalues>
+
+#include "clothlab/damping.hpp"
+#include "clothlab/gravity.hpp"
+#include "clothlab/implicit_euler.hpp"
+#include "clothlab/integrator.hpp"
+#include "clothlab/scene.hpp"
+#include "clothlab/spring_damper.hpp"
+#include "clothlab/stability.hpp"
+#include "clothlab/world.hpp"
+
+using clothlab::Index;
+using clothlab::Vec3;
+using clothlab::World;
+
+namespace {
+
+const std::vector<std::string> kMethods = {
+    "explicit-euler",  "symplectic-euler", "midpoint",      "rk4",
+    "velocity-verlet", "position-verlet",  "implicit-euler"};
+
+// A unit mass on a spring (ks = w^2, kd = beta, rest length 1 m) to a pinned anchor at the
+// origin, displaced by x along the spring with velocity v: exactly the oscillator
+// x'' = -w^2 x - beta x' while it stays on the positive x axis.
+World oscillator(const std::string& method, double omega, double beta, double x, double v) {
+  World world;
+  world.particles.add(Vec3::Zero(), Vec3::Zero(), 1.0);
+  world.particles.inv_m[0] = 0.0;
+  world.particles.add(Vec3(1.0 + x, 0.0, 0.0), Vec3(v, 0.0, 0.0), 1.0);
+  clothlab::SpringSet spring;
+  spring.add(0, 1, omega * omega, beta, 1.0, world.particles.x);
+  world.force_effects.push_back(
+      std::make_unique<clothlab::SpringDampers>("springs", std::move(spring)));
+  world.integrator = clothlab::make_integrator(method);
+  if (auto* implicit = dynamic_cast<clothlab::ImplicitEuler*>(world.integrator.get()))
+    implicit->tolerance = 1e-15;
+  return world;
+}
+
+double displacement(const World& world) {
+  return world.particles.x(0, 1) - 1.0;
+}
+
+}  // namespace
+
+TEST_CASE("advisor: each step matrix is the engine's integrator, step for step") {
+  const double omega = 7.0, beta = 1.3, dt = 0.05;
+  for (const std::string& method : kMethods) {
+    CAPTURE(method);
+    World world = oscillator(method, omega, beta, 0.2, -0.7);
+    const Eigen::MatrixXd a = clothlab::oscillator_step_matrix(method, dt, omega, beta);
+    if (method != "position-verlet") {
+      // Ten steps, each compared with the matrix applied to the state before it.
+      for (int s = 0; s < 10; ++s) {
+        const Eigen::Vector2d before(displacement(world), world.particles.v(0, 1));
+        world.step(dt);
+        const Eigen::Vector2d expected = a * before;
+        CHECK(displacement(world) == doctest::Approx(expected[0]).epsilon(1e-9));
+        CHECK(world.particles.v(0, 1) == doctest::Approx(expected[1]).epsilon(1e-9));
+      }
+    } else {
+      // The state is (x_n, x_n-1, a_n-1): take two steps to have a history, then compare.
+      // a_n-1 is the acceleration at step n-1's start, -w^2 x - beta v there.
+      double x_prev = displacement(world), v_prev = world.particles.v(0, 1);
+      world.step(dt);
+      for (int s = 0; s < 10; ++s) {
+        const double a_prev = -omega * omega * x_prev - beta * v_prev;
+        const Eigen::Vector3d before(displacement(world), x_prev, a_prev);
+        x_prev = displacement(world);
+        v_prev = world.particles.v(0, 1);
+        world.step(dt);
+        const Eigen::Vector3d expected = a * before;
+        CHECK(displacement(world) == doctest::Approx(expected[0]).epsilon(1e-9));
+      }
+    }
+  }
+}
+
+TEST_CASE("advisor: undamped limits are the textbook's y = dt w bounds") {
+  const double omega = 10.0;
+  // Symplectic Euler and both Verlets: y < 2. RK4: y < 2 sqrt 2.
+  for (const char* method : {"symplectic-euler", "velocity-verlet", "position-verlet"}) {
+    CAPTURE(method);
+    CHECK(clothlab::oscillator_dt_limit(method, omega, 0.0) * omega ==
+          doctest::Approx(2.0).epsilon(1e-6));
+  }
+  CHECK(clothlab::oscillator_dt_limit("rk4", omega, 0.0) * omega ==
+        doctest::Approx(2.0 * std::sqrt(2.0)).epsilon(1e-6));
+  // Explicit Euler and midpoint gain energy at every dt; implicit Euler never does.
+  CHECK(clothlab::oscillator_dt_limit("explicit-euler", omega, 0.0) == 0.0);
+  CHECK(clothlab::oscillator_dt_limit("midpoint", omega, 0.0) == 0.0);
+  CHECK(std::isinf(clothlab::oscillator_dt_limit("implicit-euler", omega, 0.0)));
+}
+
+TEST_CASE("advisor: damped limits match dt^2 k + 2 dt c = 4 m and dt = c / k") {
+  const double k = 100.0, m = 1.0;
+  for (double c : {0.5, 2.0, 8.0}) {
+    CAPTURE(c);
+    // Symplectic Euler: the positive root of k dt^2 + 2 c dt - 4 m = 0. Damping SHRINKS it.
+    const double symplectic = (-2.0 * c + std::sqrt(4.0 * c * c + 16.0 * k * m)) / (2.0 * k);
+    CHECK(clothlab::oscillator_dt_limit("symplectic-euler", std::sqrt(k / m), c / m) ==
+          doctest::Approx(symplectic).epsilon(1e-6));
+    // Explicit Euler, underdamped: |1 + dt lambda|^2 = 1 - dt c/m + dt^2 k/m < 1, dt < c / k.
+    CHECK(clothlab::oscillator_dt_limit("explicit-euler", std::sqrt(k / m), c / m) ==
+          doctest::Approx(c / k).epsilon(1e-6));
+  }
+}
+
+TEST_CASE("advisor: Gershgorin's bound is exact for one spring and a free pair") {
+  // One spring to a pinned anchor: w = sqrt(k / m).
+  World anchored = oscillator("symplectic-euler", 12.0, 0.0, 0.0, 0.0);
+  CHECK(clothlab::stiffness_bounds(anchored).omega_max == doctest::Approx(12.0));
+  // A free pair of masses m: the reduced mass m/2 gives w = sqrt(2 k / m).
+  World pair;
+  pair.particles.add(Vec3::Zero(), Vec3::Zero(), 2.0);
+  pair.particles.add(Vec3(1, 0, 0), Vec3::Zero(), 2.0);
+  clothlab::SpringSet spring;
+  spring.add(0, 1, 50.0, 3.0, -1.0, pair.particles.x);
+  pair.force_effects.push_back(
+      std::make_unique<clothlab::SpringDampers>("springs", std::move(spring)));
+  pair.integrator = clothlab::make_integrator("symplectic-euler");
+  const clothlab::StiffnessBounds b = clothlab::stiffness_bounds(pair);
+  CHECK(b.omega_max == doctest::Approx(std::sqrt(2.0 * 50.0 / 2.0)));
+  CHECK(b.beta_max == doctest::Approx(2.0 * 3.0 / 2.0));
+  CHECK(b.beta_min == 0.0);  // no [damping]: some motion (the pair's drift) is undamped
+}
+
+TEST_CASE("advisor: on a cloth the bound lies above the true highest frequency, within 2x") {
+  const clothlab::Scene scene = clothlab::parse_scene(R"(
+[cloth]
+rows = 6
+cols = 5
+spacing = 0.1
+mass = 0.3
+pins = "top-corners"
+[springs]
+ks = 200.0
+shear_ks = 40.0
+[integrator]
+dt = 0.001
+duration = 0.01
+)",
+                                                      "<cloth>");
+  const World& world = scene.world;
+  const clothlab::Particles& p = world.particles;
+  // The true w_max^2: the largest eigenvalue of M^-1/2 K M^-1/2 for the free particles, with K
+  // assembled densely from the springs' Jacobians.
+  const Index n = p.size();
+  Eigen::MatrixXd k = Eigen::MatrixXd::Zero(3 * n, 3 * n);
+  struct Dense final : clothlab::ForceJacobians {
+    Eigen::MatrixXd& k;
+    explicit Dense(Eigen::MatrixXd& m) : k(m) {}
+    void add_pair(Index i, Index j, const clothlab::Mat3& dfdx, const clothlab::Mat3&) override {
+      k.block<3, 3>(3 * i, 3 * j) += dfdx;
+      k.block<3, 3>(3 * j, 3 * i) += dfdx;
+      k.block<3, 3>(3 * i, 3 * i) -= dfdx;
+      k.block<3, 3>(3 * j, 3 * j) -= dfdx;
+    }
+    void add_self(Index, const clothlab::Mat3&, const clothlab::Mat3&) override {}
+  } dense(k);
+  for (const auto& effect : world.force_effects)
+    effect->add_jacobians(p, p.x, p.v, dense);
+  for (Index i = 0; i < n; ++i) {
+    for (Index j = 0; j < n; ++j) {
+      const double scale = std::sqrt(p.inv_m[i] * p.inv_m[j]);  // 0 on a pinned row or column
+      k.block<3, 3>(3 * i, 3 * j) *= scale;
+    }
+  }
+  const double w_true = std::sqrt((-k).selfadjointView<Eigen::Lower>().eigenvalues().maxCoeff());
+  const double w_bound = clothlab::stiffness_bounds(world).omega_max;
+  CAPTURE(w_true);
+  CAPTURE(w_bound);
+  CHECK(w_bound >= w_true * (1.0 - 1e-12));
+  CHECK(w_bound <= 2.0 * w_true);
+}
+
+TEST_CASE("advisor: it warns above the limit, not below, and its suggestion is stable") {
+  const double omega = 10.0;  // symplectic Euler's limit: dt < 2 / w = 0.2 s
+  World below = oscillator("symplectic-euler", omega, 0.0, 0.3, 0.0);
+  CHECK(clothlab::advise_time_step(below, 0.19, 1000).warning.empty());
+  World above = oscillator("symplectic-euler", omega, 0.0, 0.3, 0.0);
+  const clothlab::TimeStepAdvice advice = clothlab::advise_time_step(above, 0.21, 1000);
+  CHECK(advice.dt_limit == doctest::Approx(0.2).epsilon(1e-6));
+  REQUIRE_FALSE(advice.warning.empty());
+  CHECK(advice.warning.find("above the stability limit of symplectic-euler") != std::string::npos);
+  CHECK(advice.warning.find("implicit-euler") != std::string::npos);
+  // Run at the dt it suggests: the energy stays bounded.
+  const auto at = advice.warning.find("Take dt <= ");
+  REQUIRE(at != std::string::npos);
+  const double suggested = std::stod(advice.warning.substr(at + 11));
+  CHECK(suggested < 0.2);
+  for (int s = 0; s < 2000; ++s)
+    above.step(suggested);
+  // Stable, not accurate: symplectic Euler keeps H = v^2 + w^2 x^2 - dt w^2 x v, not the
+  // energy E = v^2 + w^2 x^2 (in units of m/2). Since |dt w^2 x v| <= (y / 2) E, E stays below
+  // H / (1 - y / 2), 10 times its start at y = 1.8, but it never grows past that.
+  const double y = suggested * omega;
+  CHECK(above.kinetic_energy() + above.potential_energy() <=
+        0.5 * 100.0 * 0.09 / (1.0 - y / 2.0) * (1.0 + 1e-9));
+}
+
+TEST_CASE("advisor: explicit Euler is flagged by the growth over the run") {
+  World world = oscillator("explicit-euler", 10.0, 0.0, 0.3, 0.0);
+  // Energy factor 1 + y^2 a step: y = 0.01 over 100 steps grows the amplitude by
+  // (1 + 1e-4)^50 ~ 1.005 (fine); over 100 000 steps by e^5 ~ 150 (flagged).
+  CHECK(clothlab::advise_time_step(world, 0.001, 100).warning.empty());
+  const clothlab::TimeStepAdvice advice = clothlab::advise_time_step(world, 0.001, 100000);
+  CHECK(advice.dt_limit == 0.0);
+  CHECK(advice.growth == doctest::Approx(std::exp(0.5 * 100000 * std::log1p(1e-4))));
+  CHECK(advice.warning.find("adds energy at every step") != std::string::npos);
+}
+
+TEST_CASE("guard: a slow energy runaway stops long before the speed bound") {
+  // Explicit Euler on an undamped spring multiplies the energy by 1 + y^2 every step: with
+  // y = 0.1 that is 1.01, and the energy passes 1 + 10^4 times its start (the default
+  // max_energy_growth over the scene's energy scale, here the spring's 4.5 J) after
+  // ln(10001) / ln(1.01) = 925.6 steps, at speeds of a few hundred m/s, far below the bound.
+  // A zero-length spring keeps the force exactly linear however far the particle swings.
+  World world;
+  world.particles.add(Vec3::Zero(), Vec3::Zero(), 1.0);
+  world.particles.inv_m[0] = 0.0;
+  world.particles.add(Vec3(0.3, 0.0, 0.0), Vec3::Zero(), 1.0);
+  clothlab::SpringSet spring;
+  spring.add(0, 1, 100.0, 0.0, 0.0, world.particles.x);
+  world.force_effects.push_back(
+      std::make_unique<clothlab::SpringDampers>("springs", std::move(spring)));
+  world.integrator = clothlab::make_integrator("explicit-euler");
+  long stopped_at = -1;
+  std::string message;
+  try {
+    for (int s = 0; s < 5000; ++s)
+      world.step(0.01);
+  } catch (const clothlab::SimulationError& e) {
+    stopped_at = e.step();
+    message = e.what();
+  }
+  const double first_over = std::log(10001.0) / std::log(1.01);
+  CHECK(stopped_at > first_over);
+  CHECK(stopped_at <= first_over + 32);  // the energy is checked every 32 steps
+  CHECK(message.find("ran away") != std::string::npos);
+  CHECK(message.find("particle 1") != std::string::npos);
+  CHECK(world.particles.v.cwiseAbs().maxCoeff() < 1e3);
+}
+
+TEST_CASE("guard: a falling or bouncing particle has its fall as energy scale") {
+  // One particle alone has no size and no stored energy: the energy gravity releases as it
+  // falls is the yardstick. Explicit Euler's free fall gains m g^2 dt^2 / 2 a step, which stays
+  // a small fraction of what the fall released, so the run must not be stopped.
+  World world;
+  world.particles.add(Vec3(0.0, 100.0, 0.0), Vec3::Zero(), 1.0);
+  world.force_effects.push_back(std::make_unique<clothlab::UniformGravity>(Vec3(0, -9.8, 0)));
+  world.integrator = clothlab::make_integrator("explicit-euler");
+  for (int s = 0; s < 2000; ++s)
+    world.step(0.002);
+  // The last check was at step 1984 (every 32 steps): m g (g t^2 / 2) at t = 3.968 s, less
+  // explicit Euler's lag of g dt t / 2.
+  const double t = 1984 * 0.002;
+  CHECK(world.guard.energy_scale() ==
+        doctest::Approx(9.8 * (0.5 * 9.8 * t * t - 0.5 * 9.8 * 0.002 * t)).epsilon(1e-9));
+}
+
+TEST_CASE("guard: the energy check leaves a damped, driven or falling scene alone") {
+  // A flag in a strong wind under gravity for 4 s: energy grows (the wind does work) but stays
+  // within the scene's energy scale.
+  clothlab::Scene scene = clothlab::parse_scene(R"(
+[cloth]
+rows = 8
+cols = 8
+spacing = 0.1
+mass = 0.2
+pins = "left-edge"
+[springs]
+ks = 300.0
+kd = 0.5
+[gravity]
+[aerodynamics]
+wind = [12.0, 0.0, 3.0]
+[integrator]
+method = "symplectic-euler"
+dt = 0.001
+duration = 4.0
+)",
+                                                "<flag>");
+  for (long s = 0; s < scene.step_count(); ++s)
+    scene.world.step(scene.dt);
+  CHECK(scene.world.guard.energy_scale() > 0.0);
+}
+
+TEST_CASE("guard: max_energy_growth is read from [guard]") {
+  const clothlab::Scene scene = clothlab::parse_scene(R"(
+[[particle]]
+position = [0.0, 0.0, 0.0]
+mass = 1.0
+[guard]
+max_energy_growth = 5.0
+[integrator]
+dt = 0.01
+duration = 1.0
+)",
+                                                      "<guard>");
+  CHECK(scene.world.guard.max_energy_growth == 5.0);
+}
