@@ -45,6 +45,10 @@ class Aerodynamics final : public ForceEffect {
                   Matrix3X& f) const override;
   // Wind may change while the simulation runs (a gust, a game's weather).
   void set_wind(const Vec3& v_air) { v_air_ = v_air; }
+  // 1/2 M |wind|^2: the kinetic energy of particles carried along at the wind's speed.
+  double energy_scale(const Particles& p, const Matrix3X& /*x*/, double /*size*/) const override {
+    return 0.5 * p.m.sum() * v_air_.squaredNorm();
+  }
   const std::vector<Triangle>& triangles() const { return triangles_; }
   // Drops the triangles a tear has opened (lesson 06).
   template <class Predicate>
@@ -66,6 +70,10 @@ class FluidDrag final : public ForceEffect {
   std::string_view name() const override { return "drag"; }
   void add_forces(const Particles& p, const Matrix3X& x, const Matrix3X& v,
                   Matrix3X& f) const override;
+  // 1/2 M |v_fluid|^2, as for the wind on triangles.
+  double energy_scale(const Particles& p, const Matrix3X& /*x*/, double /*size*/) const override {
+    return 0.5 * p.m.sum() * v_air_.squaredNorm();
+  }
 
  private:
   double rho_;   // fluid density [kg/m^3]
@@ -86,6 +94,13 @@ class Buoyancy final : public ForceEffect {
                   Matrix3X& f) const override;
   // The fluid's push is conservative: U = -rho V g (surface - y) below the surface, 0 above.
   double potential_energy(const Particles& p, const Matrix3X& x) const override;
+  double released_energy(const Particles& p, const Matrix3X& x0, const Matrix3X& x) const override {
+    return std::abs(potential_energy(p, x) - potential_energy(p, x0));
+  }
+  // rho V g size for every particle: what rising through the scene's size can release.
+  double energy_scale(const Particles& p, const Matrix3X& /*x*/, double size) const override {
+    return static_cast<double>(p.size()) * rho_ * volume_ * g_ * size;
+  }
 
  private:
   double rho_;      // fluid density [kg/m^3]

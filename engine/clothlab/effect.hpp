@@ -8,6 +8,7 @@
 // never once per particle.
 #pragma once
 
+#include <cmath>
 #include <string_view>
 
 #include "clothlab/particles.hpp"
@@ -49,6 +50,23 @@ class ForceEffect {
 
   // The potential energy this effect stores at positions x [J]; 0 for forces without one.
   virtual double potential_energy(const Particles& /*p*/, const Matrix3X& /*x*/) const {
+    return 0.0;
+  }
+
+  // The energy [J] this effect can give the particles, as a yardstick for the guard's
+  // energy-runaway check: for a conservative force the energy it stores at x, |U(x)|; a force
+  // that can feed energy in (gravity over the scene's size, wind) says how much. `size` [m] is
+  // the diagonal of the particles' bounding box.
+  virtual double energy_scale(const Particles& p, const Matrix3X& x, double /*size*/) const {
+    return std::abs(potential_energy(p, x));
+  }
+
+  // The energy [J] an external field (gravity, gravitation, buoyancy) has released between
+  // positions x0 and x, |U(x) - U(x0)|: a ball that has fallen far has that much energy to
+  // show for it. Springs and other internal forces release none: their energy is what a
+  // runaway shows up in. The guard widens its yardstick by the most released so far.
+  virtual double released_energy(const Particles& /*p*/, const Matrix3X& /*x0*/,
+                                 const Matrix3X& /*x*/) const {
     return 0.0;
   }
 

@@ -13,4 +13,8 @@ double UniformGravity::potential_energy(const Particles& p, const Matrix3X& x) c
   return -g_.dot(x * p.m);
 }
 
+double UniformGravity::energy_scale(const Particles& p, const Matrix3X& /*x*/, double size) const {
+  return p.m.sum() * g_.norm() * size;
+}
+
 }  // namespace clothlab

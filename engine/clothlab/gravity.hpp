@@ -20,6 +20,11 @@ class UniformGravity final : public ForceEffect {
                   Matrix3X& f) const override;
   // U = -sum m g.x: lifting a particle against g stores energy.
   double potential_energy(const Particles& p, const Matrix3X& x) const override;
+  // M |g| size: what falling the scene's size releases (U itself depends on the origin).
+  double energy_scale(const Particles& p, const Matrix3X& x, double size) const override;
+  double released_energy(const Particles& p, const Matrix3X& x0, const Matrix3X& x) const override {
+    return std::abs(potential_energy(p, x) - potential_energy(p, x0));
+  }
   const Vec3& g() const { return g_; }
 
  private:

@@ -1,5 +1,6 @@
 #include "clothlab/guard.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 #include <fmt/format.h>
@@ -23,7 +24,7 @@ Index first_bad_column(const Matrix3X& a, double bound) {
 
 }  // namespace
 
-void Guard::check(const World& world) const {
+void Guard::check(const World& world, bool before_step) const {
   const Particles& p = world.particles;
   // Fast path: one vectorised pass over each array. |a| <= bound is false for a NaN (every
   // comparison with NaN is false), so this one test catches NaN, infinity and runaway values.
@@ -52,11 +53,59 @@ void Guard::check(const World& world) const {
             "another integrator); a force with the wrong sign does the same at any dt"
           : "A NaN usually comes from a division by zero (a zero length, two particles at the "
             "same place) or from values that overflowed after growing without bound";
+  if (before_step) {
+    throw SimulationError(
+        fmt::format("simulation blew up before step {} (t = {:.6g} s): particle {} {}, and it "
+                    "was not after the last step: something outside the step (your own code, "
+                    "or a change to the state between steps) put it there. Effects in play: {}",
+                    world.steps + 1, world.t, i, problem, world.effects_in_play()),
+        world.steps + 1, i);
+  }
   throw SimulationError(
       fmt::format("simulation blew up at step {} (t = {:.6g} s): particle {} {}. Effects in play: "
                   "{}. {}",
                   world.steps, world.t, i, problem, world.effects_in_play(), advice),
       world.steps, i);
+}
+
+void Guard::start(const World& world) {
+  const Particles& p = world.particles;
+  energy_start_ = world.kinetic_energy() + world.potential_energy();
+  double size = 0.0;
+  if (p.size() > 0) size = (p.x.rowwise().maxCoeff() - p.x.rowwise().minCoeff()).norm();
+  energy_scale_ = world.kinetic_energy();
+  for (const auto& effect : world.force_effects)
+    energy_scale_ += effect->energy_scale(p, p.x, size);
+  x_start_ = p.x;
+  released_ = 0.0;
+}
+
+void Guard::check_energy(const World& world) const {
+  const Particles& p = world.particles;
+  const double energy = world.kinetic_energy() + world.potential_energy();
+  if (x_start_.cols() == p.size()) {
+    double released = 0.0;
+    for (const auto& effect : world.force_effects)
+      released += effect->released_energy(p, x_start_, p.x);
+    released_ = std::max(released_, released);
+  }
+  const double allowed = max_energy_growth * energy_scale();
+  // !(gain <= allowed) also catches a NaN energy.
+  if (energy - energy_start_ <= allowed) return;
+  // Name the particle that moves fastest: where the energy went.
+  Index fastest = 0;
+  if (p.size() > 0) p.v.colwise().squaredNorm().maxCoeff(&fastest);
+  throw SimulationError(
+      fmt::format("simulation ran away at step {} (t = {:.6g} s): the total energy rose from "
+                  "{:.6g} J to {:.6g} J, more than max_energy_growth = {} times the scene's "
+                  "energy scale of {:.3g} J, energy that no force put in; particle {} moves "
+                  "fastest ({:.3g} m/s). Effects in play: {}. The integrator is adding energy: "
+                  "dt is above its stability limit, or the method gains energy at any dt on "
+                  "undamped springs (explicit Euler, midpoint). `clothlab validate` estimates "
+                  "the limit; raise [guard] max_energy_growth if the energy is meant to grow",
+                  world.steps, world.t, energy_start_, energy, max_energy_growth, energy_scale(),
+                  fastest, p.v.col(fastest).norm(), world.effects_in_play()),
+      world.steps, fastest);
 }
 
 }  // namespace clothlab

@@ -30,10 +30,42 @@ class SimulationError : public std::runtime_error {
 
 struct Guard {
   double max_position = 1e6;  // largest |coordinate| a particle may reach [m]
-  double max_speed = 1e6;     // largest |velocity component| [m/s]; runaway energy shows here
+  double max_speed = 1e6;     // largest |velocity component| [m/s]
+
+  // The energy-runaway check. An unstable integrator adds energy a little every step; the
+  // bounds above notice only once that has grown enormous, long after the cloth stopped
+  // meaning anything. So every `energy_check_every` steps the guard compares the total energy
+  // (kinetic + potential) with what it was at the start: a rise of more than
+  // max_energy_growth times the scene's energy scale (the kinetic energy at the start plus
+  // what each effect can give: the springs' stored energy, gravity over the scene's size, the
+  // wind's 1/2 M |wind|^2) is energy no force put in, and stops the run.
+  double max_energy_growth = 1e4;
+  long energy_check_every = 32;
+
+  // (An external field such as gravity adds, to that scale, the most energy it has released
+  // so far: a ball that fell 100 m may move much faster than anything at the start.)
 
   // Throws SimulationError if any position or velocity is NaN, infinite or beyond the bounds.
-  void check(const World& world) const;
+  // `before_step` says the state is the one a step is about to start from (something outside
+  // the integrator changed it since the last check): the error then names the step about to
+  // be taken, before a NaN can spread from the particle that has it to its neighbours.
+  void check(const World& world, bool before_step = false) const;
+
+  // Records the energy and the energy scale at the start of a run (World::step calls it
+  // before the first step).
+  void start(const World& world);
+
+  // Throws SimulationError if the energy has run away since start(); call after a step.
+  void check_energy(const World& world) const;
+
+  double energy_start() const { return energy_start_; }
+  double energy_scale() const { return energy_scale_ + released_; }
+
+ private:
+  double energy_start_ = 0.0;    // [J]
+  double energy_scale_ = 0.0;    // [J] at the start
+  Matrix3X x_start_;             // positions at the start [m]
+  mutable double released_ = 0;  // [J] the most energy external fields have released so far
 };
 
 }  // namespace clothlab

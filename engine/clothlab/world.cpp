@@ -14,6 +14,10 @@ double seconds_since(Clock::time_point start) {
 
 void World::step(double dt) {
   assert(integrator && "a world needs an integrator before it can step");
+  if (steps == 0) guard.start(*this);
+  // The state the step starts from: the last step left it valid, but code between steps may
+  // have changed it. One vectorised pass; it names the particle before a NaN can spread.
+  guard.check(*this, /*before_step=*/true);
   if (!timing) {
     integrator->advance(*this, dt);  // calls compute_forces (steps 1-2) as often as it needs
     for (const auto& effect : post_step_effects)
@@ -21,6 +25,7 @@ void World::step(double dt) {
     t += dt;
     ++steps;
     guard.check(*this);
+    if (steps % guard.energy_check_every == 0) guard.check_energy(*this);
     return;
   }
   // The same step, timed part by part (for --stats).
@@ -44,6 +49,7 @@ void World::step(double dt) {
   ++steps;
   start = Clock::now();
   guard.check(*this);
+  if (steps % guard.energy_check_every == 0) guard.check_energy(*this);
   timing->guard += seconds_since(start);
 }
 
