@@ -23,7 +23,8 @@ namespace clothlab {
 Vec3 aerodynamic_force(const Vec3& r1, const Vec3& r2, const Vec3& r3, const Vec3& v1,
                        const Vec3& v2, const Vec3& v3, const Vec3& v_air, double rho, double cd) {
   // BEGIN ex03.1: see lessons/03-aerodynamics/README.md
-  const Vec3 v = (v1 + v2 + v3) / 3.0 - v_air;   // relative velocity [m/s]
+  // Relative velocity [m/s], each corner's taken first: exactly zero when all move with the air.
+  const Vec3 v = ((v1 - v_air) + (v2 - v_air) + (v3 - v_air)) / 3.0;
   const Vec3 n_star = (r2 - r1).cross(r3 - r1);  // normal, |n*| = twice the area [m^2]
   const double n_star_norm = n_star.norm();
   const double speed = v.norm();

@@ -39,8 +39,8 @@ class AccuracyProblem {
 
 // One particle of mass m on a spring (ks, kd, rest length 1 m) to a pinned anchor, released at
 // rest from a stretch of 0.5 m: a damped harmonic oscillator with w = sqrt(ks/m) and
-// zeta = kd / (2 sqrt(ks m)) (underdamped: zeta < 1). Stable means the energy at the end is no
-// more than at the start: a damped system that gained energy was made to by its integrator.
+// zeta = kd / (2 sqrt(ks m)) (underdamped: zeta < 1). Stable means the integrator's step matrix
+// on this oscillator has no eigenvalue beyond 1 in modulus (stability.hpp).
 class DampedOscillatorProblem final : public AccuracyProblem {
  public:
   DampedOscillatorProblem(double mass, double ks, double zeta, double end_time);

@@ -104,7 +104,9 @@ void ViewerRecorder::write(const World& world, const std::filesystem::path& html
   std::string frames = "[";
   for (const std::vector<float>& frame : positions_) {
     if (frames.size() > 1) frames += ",";
-    frames += "\"" + base64(frame.data(), frame.size() * sizeof(float)) + "\"";
+    frames += '"';
+    frames += base64(frame.data(), frame.size() * sizeof(float));
+    frames += '"';
   }
   frames += "]";
   const std::string json = fmt::format(
