@@ -18,6 +18,8 @@ PICTURES = {
     "04-bending-springs": ("drape-stiff.toml", -1),
     "05-ground-collision": ("cloth-on-sphere.toml", -1),
     "06-plasticity-and-tearing": ("storm-flag.toml", 25),
+    "07-integrators": ("pendulum-cloth.toml", 10),
+    "08-stability": ("stiff-sheet-implicit.toml", -1),
 }
 
 
