@@ -89,7 +89,8 @@ std::string describe_range(const Range& r) {
   const bool has_min = std::isfinite(r.min);
   const bool has_max = std::isfinite(r.max);
   if (has_min && has_max) {
-    text = fmt::format("a number from {} to {}", r.min, r.max);
+    text = r.min_exclusive ? fmt::format("a number > {} and <= {}", r.min, r.max)
+                           : fmt::format("a number from {} to {}", r.min, r.max);
   } else if (has_min) {
     text = fmt::format("a number {} {}", r.min_exclusive ? ">" : ">=", r.min);
   } else {
@@ -161,7 +162,8 @@ Vec3 SceneTable::vec3(std::string_view key, std::string_view unit, const Vec3& f
   const std::string expected = fmt::format("an array of three numbers [x, y, z] [{}]", unit);
   if (!array) {
     fail_at(source_, node->source(),
-            fmt::format("'{}' in {} is {}; expected {}", key, name_, type_name(*node), expected));
+            fmt::format("'{}' in {} is {}; expected {}", key, name_, clothlab::type_name(*node),
+                        expected));
   }
   if (array->size() != 3) {
     fail_at(source_, node->source(),
@@ -188,6 +190,15 @@ namespace {
 long checked_integer(const toml::node& node, const std::string& source, std::string_view what,
                      long min, long max) {
   const auto* i = node.as_integer();
+  if (const auto* d = node.as_floating_point()) {
+    // "rows = 3.0" is a floating-point number in TOML; name it as written, with its point.
+    std::string value = fmt::format("{}", d->get());
+    if (value.find_first_of(".eni") == std::string::npos) value += ".0";
+    fail_at(source, node.source(),
+            fmt::format("{} is {}, not a whole number; expected a whole number from {} to {} "
+                        "(written without a decimal point)",
+                        what, value, min, max));
+  }
   if (!i) {
     fail_at(source, node.source(),
             fmt::format("{} is {}; expected a whole number from {} to {}", what, type_name(node),
@@ -225,8 +236,8 @@ std::vector<long> SceneTable::integer_list(std::string_view key, long min, long 
   const toml::array* array = node->as_array();
   if (!array) {
     fail_at(source_, node->source(),
-            fmt::format("'{}' in {} is {}; expected an array of {}s", key, name_, type_name(*node),
-                        what));
+            fmt::format("'{}' in {} is {}; expected an array of whole numbers from {} to {}", key,
+                        name_, clothlab::type_name(*node), min, max));
   }
   for (size_t k = 0; k < array->size(); ++k) {
     values.push_back(checked_integer(
@@ -240,7 +251,8 @@ bool SceneTable::boolean(std::string_view key, bool fallback) {
   if (!node) return fallback;
   if (const auto* b = node->as_boolean()) return b->get();
   fail_at(source_, node->source(),
-          fmt::format("'{}' in {} is {}; expected true or false", key, name_, type_name(*node)));
+          fmt::format("'{}' in {} is {}; expected true or false", key, name_,
+                      clothlab::type_name(*node)));
 }
 
 bool SceneTable::has(std::string_view key) const {
@@ -252,12 +264,23 @@ bool SceneTable::is_string(std::string_view key) const {
   return node && node->is_string();
 }
 
+bool SceneTable::is_array(std::string_view key) const {
+  const toml::node* node = as_table(node_).get(key);
+  return node && node->is_array();
+}
+
+std::string_view SceneTable::type_name(std::string_view key) const {
+  const toml::node* node = as_table(node_).get(key);
+  return node ? clothlab::type_name(*node) : "missing";
+}
+
 std::optional<std::string> SceneTable::string(std::string_view key) {
   const toml::node* node = as_table(node_).get(key);
   if (!node) return std::nullopt;
   if (const auto* s = node->as_string()) return s->get();
-  fail_at(source_, node->source(),
-          fmt::format("'{}' in {} is {}; expected a string", key, name_, type_name(*node)));
+  fail_at(
+      source_, node->source(),
+      fmt::format("'{}' in {} is {}; expected a string", key, name_, clothlab::type_name(*node)));
 }
 
 std::string SceneTable::choice(std::string_view key, const std::vector<std::string_view>& choices,
@@ -313,16 +336,89 @@ std::string nearest_name(std::string_view typo, std::string_view candidates) {
 
 // --- Reading a whole scene -------------------------------------------------------------------
 
+namespace {
+
+// The text from LINE:COLUMN (1-based, columns counting characters as toml++ does) to the end of
+// its line, or "" past the end of the text.
+std::string_view rest_of_line(std::string_view text, const toml::source_position& at) {
+  size_t k = 0;
+  for (toml::source_index line = 1; line < at.line; ++line) {
+    k = text.find('\n', k);
+    if (k == std::string_view::npos) return {};
+    ++k;
+  }
+  for (toml::source_index column = 1; column < at.column && k < text.size(); ++column) {
+    ++k;  // one character: its first byte and any UTF-8 continuation bytes (10xxxxxx)
+    while (k < text.size() && (static_cast<unsigned char>(text[k]) & 0xC0) == 0x80)
+      ++k;
+  }
+  const std::string_view rest = text.substr(std::min(k, text.size()));
+  return rest.substr(0, rest.find_first_of("\r\n"));
+}
+
+// A toml++ syntax error in the reader's words. toml++ says e.g. "Error while parsing array:
+// expected comma or closing ']', saw 'm'", which already names what was expected; the mistakes
+// whose wording is cryptic (an unclosed string, a key given twice, a word without quotes) are
+// said here instead, and anything else gets an "expected" if it has none.
+std::string explain_toml_error(std::string_view text, const toml::parse_error& error) {
+  const std::string_view d = error.description();
+  const toml::source_position at = error.source().begin;
+  constexpr auto npos = std::string_view::npos;
+
+  // An unclosed string: toml++ stops at the newline (a control character) or the end of file.
+  if (d.find("parsing string") != npos || d.find("parsing literal string") != npos) {
+    if (d.find("end-of-file") != npos) {
+      return "the string is not closed before the end of the file; expected a closing quote";
+    }
+    if (d.find("control characters") != npos && rest_of_line(text, at).empty()) {
+      return "the string is not closed on its line; expected a closing quote before the end of "
+             "the line";
+    }
+  }
+  // "cannot redefine existing table 'gravity'", "cannot redefine existing integer 'rows'".
+  if (const size_t k = d.find("cannot redefine existing "); k != npos) {
+    const size_t open = d.find('\'', k);
+    const size_t close = open == npos ? npos : d.find('\'', open + 1);
+    if (close != npos) {
+      const std::string_view name = d.substr(open + 1, close - open - 1);
+      if (d.substr(k).starts_with("cannot redefine existing table")) {
+        return fmt::format(
+            "[{}] is defined twice; expected each table once ([[{}]] for a table "
+            "that repeats, one per item)",
+            name, name);
+      }
+      return fmt::format("'{}' is given twice; expected each key once in a table", name);
+    }
+  }
+  // mass = heavy: a word where a value belongs, usually a string without its quotes.
+  if (d.find("could not determine value type") != npos) {
+    std::string_view word = rest_of_line(text, at);
+    word = word.substr(0, std::min(word.find_first_of(" \t,]}#"), size_t{40}));
+    return fmt::format(
+        "'{}' is not a value; expected a number, a \"quoted string\", true, false "
+        "or an array",
+        word);
+  }
+  std::string what(d);
+  if (!what.empty()) what[0] = static_cast<char>(std::tolower(static_cast<unsigned char>(what[0])));
+  if (d.find("could not be interpreted as a value") != npos) {
+    what += "; expected a number between -1.8e308 and 1.8e308";
+  } else if (d.find("not representable in 64 bits") != npos) {
+    what += "; expected a whole number between -9223372036854775808 and 9223372036854775807";
+  } else if (d.find("expected") == npos) {
+    what += "; expected valid TOML";
+  }
+  return what;
+}
+
+}  // namespace
+
 Scene parse_scene(std::string_view text, const std::string& source) {
   toml::table root;
   try {
     root = toml::parse(text, source);
   } catch (const toml::parse_error& error) {
-    // toml++ says e.g. "Error while parsing array: expected comma or closing ']', saw 'm'",
-    // which already names what was expected.
-    std::string what(error.description());
-    if (!what.empty()) what[0] = static_cast<char>(std::tolower(what[0]));
-    fail_at(source, error.source(), "invalid TOML: " + what);
+    fail_at(source, error.source(), "invalid TOML: " + explain_toml_error(text, error));
   }
 
   Scene scene;

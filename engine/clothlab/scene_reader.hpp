@@ -48,6 +48,9 @@ class SceneTable {
   std::optional<std::string> string(std::string_view key);
   bool has(std::string_view key) const;
   bool is_string(std::string_view key) const;
+  bool is_array(std::string_view key) const;
+  // "a string", "an integer", ...: the TOML type of `key`, for messages.
+  std::string_view type_name(std::string_view key) const;
   // A string that must be one of `choices`.
   std::string choice(std::string_view key, const std::vector<std::string_view>& choices,
                      std::string_view fallback);

@@ -1,6 +1,8 @@
 #include "clothlab/scene_tables.hpp"
 
 #include <array>
+#include <cmath>
+#include <limits>
 #include <vector>
 
 #include <fmt/format.h>
@@ -19,13 +21,58 @@ namespace clothlab {
 
 namespace {
 
+// The smallest mass a particle may have [kg]: the engine divides by it (inv_m = 1/m), and below
+// the smallest normal double, 2.2e-308, the inverse overflows to infinity.
+constexpr double kMinParticleMass = std::numeric_limits<double>::min();
+
+// Refuses a share of mass too small to divide by; `what` says where the share came from.
+void check_particle_mass(SceneTable& t, std::string_view key, double m, const std::string& what) {
+  if (m < kMinParticleMass) {
+    t.fail(key, fmt::format("{} is {} kg, too small to divide by; expected at least {:.2g} kg a "
+                            "particle",
+                            what, m, kMinParticleMass));
+  }
+}
+
+// The guard stops a run at its first step if a particle starts beyond its bounds, so such a scene
+// is refused here, where the line can be named; this also keeps a huge spacing or coordinate from
+// overflowing to infinity. [guard] is read before any particle.
+void check_within_guard(SceneTable& t, std::string_view key, const Scene& scene, Index i,
+                        std::string_view what) {
+  const double bound = scene.world.guard.max_position;
+  const Vec3 x = scene.world.particles.x.col(i);
+  // !(|x| <= bound) also catches an infinity, as in Guard::check.
+  if (!(x.array().abs() <= bound).all()) {
+    t.fail(key, fmt::format("{} starts at ({}, {}, {}) m, beyond the guard's max_position = {} m; "
+                            "expected |x|, |y|, |z| <= {} m (a larger max_position in [guard] "
+                            "allows more)",
+                            what, x.x(), x.y(), x.z(), bound, bound));
+  }
+}
+
 // [[particle]]: one point mass (lesson 01).
 void read_particle(SceneTable& t, Scene& scene) {
   const Vec3 x = t.required_vec3("position", "m");
   const Vec3 v = t.vec3("velocity", "m/s", Vec3::Zero());
   const double m = t.required_number("mass", Range::positive("kg"));
+  check_particle_mass(t, "mass", m, fmt::format("'mass' in {}", t.display_name()));
+  const bool pinned = t.boolean("pinned", false);
+  if (pinned && v != Vec3::Zero()) {
+    // pin() sets v = 0: a velocity given here would be dropped without a word.
+    t.fail("velocity", fmt::format("{} is pinned but has velocity ({}, {}, {}) m/s; expected no "
+                                   "velocity (a pinned particle never moves)",
+                                   t.display_name(), v.x(), v.y(), v.z()));
+  }
+  const double max_speed = scene.world.guard.max_speed;
+  if (!(v.array().abs() <= max_speed).all()) {
+    t.fail("velocity", fmt::format("{} starts at velocity ({}, {}, {}) m/s, beyond the guard's "
+                                   "max_speed = {} m/s; expected each component within {} m/s (a "
+                                   "larger max_speed in [guard] allows more)",
+                                   t.display_name(), v.x(), v.y(), v.z(), max_speed, max_speed));
+  }
   const Index i = scene.world.particles.add(x, v, m);
-  if (t.boolean("pinned", false)) pin(scene.world.particles, i);
+  check_within_guard(t, "position", scene, i, t.display_name());
+  if (pinned) pin(scene.world.particles, i);
 }
 
 // Pins of a builder: a name (e.g. "top-corners") or an array of local indices below `count`.
@@ -34,6 +81,11 @@ std::vector<Index> read_pins(
     const std::function<bool(std::string_view, std::vector<Index>&)>& named,
     std::string_view names) {
   std::vector<Index> pins;
+  if (t.has("pins") && !t.is_string("pins") && !t.is_array("pins")) {
+    t.fail("pins", fmt::format("'pins' in {} is {}; expected a pin set ({}) or an array of "
+                               "particle indices",
+                               t.display_name(), t.type_name("pins"), names));
+  }
   if (t.is_string("pins")) {
     const std::string name = *t.string("pins");
     if (!named(name, pins)) {
@@ -50,14 +102,28 @@ std::vector<Index> read_pins(
 }
 
 // Total mass from `mass` [kg] or from `density` [kg/m^2] times `area` [m^2]: exactly one of the
-// two keys.
-double read_mass_or_density(SceneTable& t, double area) {
+// two keys. The total is shared by `count` particles, each of which must keep a mass.
+double read_mass_or_density(SceneTable& t, double area, Index count) {
   if (t.has("mass") && t.has("density")) {
     t.fail("density", fmt::format("{} gives both mass and density; expected one of the two",
                                   t.display_name()));
   }
-  if (t.has("density")) return t.number("density", Range::positive("kg/m^2"), 0.0) * area;
-  return t.required_number("mass", Range::positive("kg"));
+  double mass = 0.0;
+  if (t.has("density")) {
+    const double rho = t.number("density", Range::positive("kg/m^2"), 0.0);
+    mass = rho * area;
+    if (!std::isfinite(mass)) {
+      t.fail("density",
+             fmt::format("density = {} kg/m^2 over an area of {:.3g} m^2 is a mass of {} "
+                         "kg; expected a finite mass",
+                         rho, area, mass));
+    }
+  } else {
+    mass = t.required_number("mass", Range::positive("kg"));
+  }
+  check_particle_mass(t, t.has("density") ? "density" : "mass", mass / static_cast<double>(count),
+                      fmt::format("the cloth's mass of {} kg shared by {} particles", mass, count));
+  return mass;
 }
 
 // [rope]: a chain of particles from start to end (lesson 02).
@@ -67,11 +133,17 @@ void read_rope(SceneTable& t, Scene& scene) {
   spec.end = t.required_vec3("end", "m");
   spec.particles = t.required_integer("particles", 2, 1000000);
   spec.mass = t.required_number("mass", Range::positive("kg"));
+  check_particle_mass(
+      t, "mass", spec.mass / static_cast<double>(spec.particles),
+      fmt::format("the rope's mass of {} kg shared by {} particles", spec.mass, spec.particles));
   if (spec.start == spec.end) {
     t.fail("end", "the rope's start and end are the same point; expected a rope of some length");
   }
   Particles& p = scene.world.particles;
   const Rope rope = add_rope(p, spec);
+  // The rope lies between its two ends.
+  check_within_guard(t, "start", scene, rope.first, "the rope's first particle");
+  check_within_guard(t, "end", scene, rope.first + rope.count - 1, "the rope's last particle");
   const auto named = [&](std::string_view name, std::vector<Index>& out) {
     if (name == "first" || name == "both") out.push_back(0);
     if (name == "last" || name == "both") out.push_back(rope.count - 1);
@@ -82,19 +154,32 @@ void read_rope(SceneTable& t, Scene& scene) {
   scene.rope = rope;
 }
 
+// The most particles a [cloth] may have, as many as a [rope] (a 1000 x 1000 grid): the 4096 x 4096
+// that rows and cols alone allow would need gigabytes before its first step.
+constexpr Index kMaxClothParticles = 1000000;
+
 // [cloth]: a rectangular grid of particles (lesson 02).
 void read_cloth(SceneTable& t, Scene& scene) {
   ClothSpec spec;
   spec.rows = t.required_integer("rows", 2, 4096);
   spec.cols = t.required_integer("cols", 2, 4096);
+  if (spec.rows * spec.cols > kMaxClothParticles) {
+    t.fail("cols", fmt::format("[cloth] of {} x {} is {} particles; expected at most {} (rows x "
+                               "cols)",
+                               spec.rows, spec.cols, spec.rows * spec.cols, kMaxClothParticles));
+  }
   spec.spacing = t.required_number("spacing", Range::positive("m"));
   spec.origin = t.vec3("origin", "m", Vec3::Zero());
   spec.horizontal = t.choice("plane", {"vertical", "horizontal"}, "vertical") == "horizontal";
   const double area = static_cast<double>(spec.rows - 1) * static_cast<double>(spec.cols - 1) *
                       spec.spacing * spec.spacing;
-  spec.mass = read_mass_or_density(t, area);
+  spec.mass = read_mass_or_density(t, area, spec.rows * spec.cols);
   Particles& p = scene.world.particles;
   const ClothGrid grid = add_cloth(p, spec);
+  // The grid lies between its first particle, at the origin, and its last.
+  check_within_guard(t, "origin", scene, grid.first, "the cloth's first particle");
+  check_within_guard(t, "spacing", scene, grid.first + grid.size() - 1,
+                     "the cloth's last particle");
   const auto named = [&](std::string_view name, std::vector<Index>& out) {
     return named_pins(grid, name, out);
   };
@@ -304,6 +389,12 @@ void read_integrator(SceneTable& t, Scene& scene) {
     t.fail("dt", fmt::format("dt = {} s is longer than duration = {} s; expected dt <= duration",
                              scene.dt, scene.duration));
   }
+  // Scene::step_count() rounds duration / dt to a whole number, which must fit in a long.
+  if (scene.duration / scene.dt > 1e9) {
+    t.fail("dt", fmt::format("dt = {} s over duration = {} s is {:.3g} steps; expected at most "
+                             "1e9 steps (a larger dt or a shorter duration)",
+                             scene.dt, scene.duration, scene.duration / scene.dt));
+  }
 }
 
 // [output]: what a run writes.
@@ -316,10 +407,15 @@ void read_guard(SceneTable& t, Scene& scene) {
   Guard& guard = scene.world.guard;
   guard.max_position = t.number("max_position", Range::positive("m"), guard.max_position);
   guard.max_speed = t.number("max_speed", Range::positive("m/s"), guard.max_speed);
+  guard.max_energy_growth =
+      t.number("max_energy_growth", Range::positive(""), guard.max_energy_growth);
 }
 
-// The order here is the order of reading: whatever creates particles comes first.
+// The order here is the order of reading: the guard's bounds, which the particles must start
+// within, then whatever creates particles, then the effects on them.
 constexpr std::array kKinds = {
+    SceneTableKind{"guard", false, false, "max_position max_speed max_energy_growth",
+                   "[guard] with max_position and max_speed", read_guard},
     SceneTableKind{"particle", true, false, "position velocity mass pinned",
                    "[[particle]] with position, velocity and mass", read_particle},
     SceneTableKind{"rope", false, false, "start end particles mass pins",
@@ -350,8 +446,6 @@ constexpr std::array kKinds = {
     SceneTableKind{"integrator", false, true, "method dt duration tolerance max_iterations",
                    "[integrator] with method, dt [s] and duration [s]", read_integrator},
     SceneTableKind{"output", false, false, "fps", "[output] with fps", read_output},
-    SceneTableKind{"guard", false, false, "max_position max_speed",
-                   "[guard] with max_position and max_speed", read_guard},
 };
 
 }  // namespace
@@ -369,8 +463,10 @@ const SceneTableKind* find_scene_table(std::string_view name) {
 
 std::string scene_table_names() {
   std::string names = "title";
-  for (const SceneTableKind& kind : kKinds)
-    names += " " + std::string(kind.name);
+  for (const SceneTableKind& kind : kKinds) {
+    names += ' ';
+    names += kind.name;
+  }
   return names;
 }
 
