@@ -5,6 +5,8 @@
 // process group with a real timeout, and reads the line protocol printed by the binary's
 // "clothlab" reporter (tests/grade/grade_main.cpp describes it).
 #include "app/grade.hpp"
+#include "app/process.hpp"
+#include "app/submission.hpp"
 
 #include <fcntl.h>
 #include <poll.h>
@@ -32,6 +34,7 @@
 #include <string_view>
 #include <system_error>
 #include <thread>
+#include <utility>
 #include <vector>
 
 namespace clothlab::app {
@@ -50,7 +53,12 @@ struct Options {
   std::string junit;
   bool require_full = false;
   bool require_zero = false;
-  std::string binary;  // hidden: grade this doctest binary instead of grade-<impl>
+  std::string binary;      // hidden: grade this doctest binary instead of grade-<impl>
+  std::string submission;  // grade the exercise files in this folder
+  std::string scratch;     // where a submission is built; default <dir of clothlab>/grade-scratch
+  double build_timeout = 600;  // [s] for configuring, then for compiling, a submission
+  bool autolab = false;        // end with Autolab's one-line JSON score summary
+  std::string classroom;       // write a GitHub Classroom workflow here, and grade nothing
 };
 
 // One grading test case: what the listing says, then how its run went.
@@ -58,10 +66,12 @@ struct Case {
   std::string suite, name, file, exercise;
   int line = 0;
   int points = 0;
+  std::string visibility = "visible";  // Gradescope: visible, hidden, after_due_date, ...
 
   bool done = false;
   bool passed = false;
-  bool not_started = false;  // failed on the stub's NotImplemented
+  bool not_started = false;   // failed on the stub's NotImplemented
+  bool not_compiled = false;  // the submission it was graded on did not compile
   std::string status = "not run";
   std::string message;  // the first failure, with its INFO/CAPTURE hints
   std::string output;   // what the case printed itself
@@ -72,125 +82,6 @@ struct Case {
   std::cout << std::flush;
   std::cerr << "clothlab grade: " << message << "\n";
   throw CLI::RuntimeError(exit_code);
-}
-
-// --- Running one process with a real timeout ------------------------------------------------
-
-volatile std::sig_atomic_t g_interrupted = 0;
-extern "C" void on_interrupt(int) {
-  g_interrupted = 1;
-}
-
-// While grading, Ctrl-C (or a TERM from an autograder) stops after killing the running case,
-// so no orphan keeps running and the results written so far stay valid.
-class InterruptGuard {
- public:
-  InterruptGuard() {
-    struct sigaction sa {};
-    sa.sa_handler = on_interrupt;
-    sigemptyset(&sa.sa_mask);
-    sa.sa_flags = 0;  // no SA_RESTART: poll() must return EINTR so we notice at once
-    sigaction(SIGINT, &sa, &old_int_);
-    sigaction(SIGTERM, &sa, &old_term_);
-  }
-  ~InterruptGuard() {
-    sigaction(SIGINT, &old_int_, nullptr);
-    sigaction(SIGTERM, &old_term_, nullptr);
-  }
-  InterruptGuard(const InterruptGuard&) = delete;
-  InterruptGuard& operator=(const InterruptGuard&) = delete;
-
- private:
-  struct sigaction old_int_ {};
-  struct sigaction old_term_ {};
-};
-
-struct ProcessResult {
-  std::string output;  // stdout and stderr, interleaved as written
-  int exit_code = 0;   // meaningful when signal == 0 and the run was not cut off
-  int signal = 0;
-  bool timed_out = false;
-  bool interrupted = false;
-};
-
-constexpr std::size_t kMaxOutput = 1 << 20;  // keep at most 1 MiB of a chatty case's output
-
-ProcessResult run_process(const std::vector<std::string>& args, double timeout) {
-  // Built before fork(): the child may only make async-signal-safe calls.
-  std::vector<char*> argv;
-  for (const auto& a : args)
-    argv.push_back(const_cast<char*>(a.c_str()));
-  argv.push_back(nullptr);
-
-  int fds[2];
-  if (pipe2(fds, O_CLOEXEC) != 0) throw std::system_error(errno, std::generic_category(), "pipe");
-  const pid_t pid = fork();
-  if (pid < 0) throw std::system_error(errno, std::generic_category(), "fork");
-  if (pid == 0) {
-    setpgid(0, 0);  // its own process group: a timeout kills whatever the case started too
-    // No terminal input: a background process group reading it would be stopped, not fail.
-    const int null_fd = open("/dev/null", O_RDONLY);
-    if (null_fd >= 0) dup2(null_fd, STDIN_FILENO);
-    dup2(fds[1], STDOUT_FILENO);
-    dup2(fds[1], STDERR_FILENO);
-    execv(argv[0], argv.data());
-    const char message[] = "clothlab grade: cannot execute the test binary\n";
-    [[maybe_unused]] auto ignored = write(STDERR_FILENO, message, sizeof message - 1);
-    _exit(127);
-  }
-  setpgid(pid, pid);  // also here, so the kill below cannot race the child's own call
-  close(fds[1]);
-
-  ProcessResult result;
-  const auto deadline = Clock::now() + std::chrono::duration<double>(timeout);
-  auto time_left_ms = [&] {
-    const auto left = std::chrono::ceil<std::chrono::milliseconds>(deadline - Clock::now());
-    return std::max<long>(0, static_cast<long>(left.count()));
-  };
-  auto stop = [&](bool& reason) {
-    kill(-pid, SIGKILL);
-    reason = true;
-  };
-
-  // Read until end of file (the case and anything it started closed the pipe) or the deadline.
-  char buffer[4096];
-  for (;;) {
-    if (g_interrupted) {
-      stop(result.interrupted);
-      break;
-    }
-    const long left = time_left_ms();
-    if (left == 0) {
-      stop(result.timed_out);
-      break;
-    }
-    pollfd p{fds[0], POLLIN, 0};
-    const int ready = poll(&p, 1, static_cast<int>(std::min<long>(left, 1000)));
-    if (ready <= 0) continue;  // timeout slice or EINTR: check the deadline and the flag again
-    const ssize_t got = read(fds[0], buffer, sizeof buffer);
-    if (got < 0 && errno == EINTR) continue;
-    if (got <= 0) break;
-    if (result.output.size() < kMaxOutput) result.output.append(buffer, static_cast<size_t>(got));
-  }
-  close(fds[0]);
-
-  // The pipe can close before the process ends: wait for it, still under the deadline.
-  int status = 0;
-  for (;;) {
-    const pid_t done = waitpid(pid, &status, WNOHANG);
-    if (done == pid) break;
-    if (done < 0 && errno != EINTR) break;
-    if (!result.timed_out && !result.interrupted) {
-      if (g_interrupted)
-        stop(result.interrupted);
-      else if (time_left_ms() == 0)
-        stop(result.timed_out);
-    }
-    std::this_thread::sleep_for(std::chrono::milliseconds(5));
-  }
-  if (WIFSIGNALED(status)) result.signal = WTERMSIG(status);
-  if (WIFEXITED(status)) result.exit_code = WEXITSTATUS(status);
-  return result;
 }
 
 // The signals a test process typically dies of, and what usually causes each.
@@ -435,7 +326,7 @@ std::vector<Case> list_cases(const std::string& binary) {
   std::vector<Case> cases;
   for (Fields& e : events) {
     if (e[0] != "case") continue;
-    e.resize(6);
+    e.resize(7);
     Case c;
     c.suite = e[1];
     c.name = e[2];
@@ -448,9 +339,31 @@ std::vector<Case> list_cases(const std::string& binary) {
           c.file, c.line, c.name);
     }
     c.points = std::atoi(e[5].c_str());
+    // A hidden test (tests/grade-hidden/) shows on Gradescope once the due date has passed,
+    // unless it says otherwise with POINTS_VISIBILITY.
+    const bool hidden_file = c.file.find("grade-hidden/") != std::string::npos;
+    c.visibility = !e[6].empty() ? e[6] : hidden_file ? "after_due_date" : "visible";
+    constexpr std::string_view kVisibilities[] = {"visible", "hidden", "after_due_date",
+                                                  "after_published"};
+    if (std::find(std::begin(kVisibilities), std::end(kVisibilities), c.visibility) ==
+        std::end(kVisibilities)) {
+      fail(2, fmt::format("{}:{}: case \"{}\" has visibility \"{}\"; expected visible, hidden, "
+                          "after_due_date or after_published",
+                          c.file, c.line, c.name, c.visibility));
+    }
     cases.push_back(c);
   }
   if (cases.empty()) fail(2, binary + " lists no test cases (was it built with grade_main.cpp?)");
+  // doctest lists by file, and a hidden file may come first: order by exercise (ex01.2 before
+  // ex01.10), keeping each exercise's cases in their order.
+  auto key = [](const Case& c) {
+    if (!is_exercise_id(c.exercise, true)) return std::pair<int, int>(1 << 30, 0);
+    const auto dot = c.exercise.find('.');
+    const int part = dot == std::string::npos ? 0 : std::atoi(c.exercise.c_str() + dot + 1);
+    return std::pair<int, int>(std::atoi(c.exercise.c_str() + 2), part);
+  };
+  std::stable_sort(cases.begin(), cases.end(),
+                   [&](const Case& a, const Case& b) { return key(a) < key(b); });
   return cases;
 }
 
@@ -521,14 +434,17 @@ std::string summary(const std::vector<Case>& cases, bool colour) {
     earned += x.earned;
     max += x.max;
     const Case* first = nullptr;
-    bool all_not_started = true, all_run = true;
+    bool all_not_started = true, all_run = true, not_compiled = false;
     for (const Case* c : x.cases) {
       if (!c->passed && first == nullptr) first = c;
       all_not_started = all_not_started && c->not_started;
       all_run = all_run && c->done;
+      not_compiled = not_compiled || c->not_compiled;
     }
     std::string status;
-    if (first == nullptr)
+    if (not_compiled)
+      status = paint(colour, red, "not compiled");
+    else if (first == nullptr)
       status = paint(colour, green, "done");
     else if (all_not_started)
       status = paint(colour, yellow, "not started: " + lesson_hint(x.id));
@@ -538,7 +454,7 @@ std::string summary(const std::vector<Case>& cases, bool colour) {
       status = paint(colour, red, "failing");
     s += fmt::format("{:<10} {:>9} {:>9}   {}\n", x.id, fmt::format("{} / {}", x.earned, x.max),
                      fmt::format("{} / {}", x.passed, x.cases.size()), status);
-    if (first != nullptr && !all_not_started && first->done) {
+    if (first != nullptr && !all_not_started && first->done && !not_compiled) {
       s += fmt::format("    {}: {}\n", paint(colour, fmt::emphasis::bold, first->name),
                        paint(colour, red, first->status));
       if (!first->message.empty()) s += indent(first->message, "      ") + "\n";
@@ -599,7 +515,7 @@ std::string xml_escape(const std::string& text) {
 std::string case_report(const Case& c, bool with_output) {
   std::string s = c.status + "\n";
   if (!c.message.empty()) s += c.message + "\n";
-  if (!c.passed && !c.not_started) {
+  if (!c.passed && !c.not_started && !c.not_compiled) {
     const std::string hint = lesson_hint(c.exercise);
     if (!hint.empty()) s += hint + "\n";
   }
@@ -628,10 +544,10 @@ std::string gradescope_json(const std::vector<Case>& cases, double seconds,
     score += c.passed ? c.points : 0;
     tests += fmt::format(
         "{}\n    {{\"name\": {}, \"number\": {}, \"score\": {}, \"max_score\": {}, "
-        "\"status\": \"{}\", \"output\": {}, \"visibility\": \"visible\"}}",
+        "\"status\": \"{}\", \"output\": {}, \"visibility\": \"{}\"}}",
         tests.empty() ? "" : ",", json_text(c.name), json_text(number_of(c.exercise)),
         c.passed ? c.points : 0, c.points, c.passed ? "passed" : "failed",
-        json_text(case_report(c, true)));
+        json_text(case_report(c, true)), c.visibility);
   }
   return fmt::format(
       "{{\n  \"score\": {},\n  \"execution_time\": {:.3f},\n  \"output\": {},\n  \"tests\": [{}\n  "
@@ -677,10 +593,92 @@ std::string junit_xml(const std::vector<Case>& cases, double seconds) {
       cases.size(), failures, seconds, suites);
 }
 
-void write_reports(const Options& o, const std::vector<Case>& cases, double seconds) {
+// notes: what the grader says before the table (how a submission was built), also shown at the
+// top of Gradescope's results.
+void write_reports(const Options& o, const std::vector<Case>& cases, double seconds,
+                   const std::string& notes) {
   if (!o.results.empty())
-    write_file(o.results, gradescope_json(cases, seconds, summary(cases, false)));
+    write_file(o.results, gradescope_json(cases, seconds, notes + summary(cases, false)));
   if (!o.junit.empty()) write_file(o.junit, junit_xml(cases, seconds));
+}
+
+// Autolab reads the last line of the grader's output: {"scores": {...}, "scoreboard": [...]},
+// one score per exercise (the problem names an Autolab course defines), the total on the
+// scoreboard.
+std::string autolab_line(const std::vector<Case>& cases) {
+  std::string scores;
+  int total = 0;
+  for (const Exercise& x : by_exercise(cases)) {
+    scores += fmt::format("{}{}: {}", scores.empty() ? "" : ", ", json_text(x.id), x.earned);
+    total += x.earned;
+  }
+  return fmt::format("{{\"scores\": {{{}}}, \"scoreboard\": [{}]}}", scores, total);
+}
+
+// A GitHub Classroom autograding workflow with one step per exercise, worth that exercise's
+// points (of the visible cases: the hidden ones are not in a student's repository). Each step
+// passes only when every case of its exercise passes.
+std::string classroom_workflow(const std::vector<Case>& cases) {
+  std::string steps, env, runners;
+  for (const Exercise& x : by_exercise(cases)) {
+    int points = 0;
+    for (const Case* c : x.cases)
+      points += c->visibility == "visible" ? c->points : 0;
+    if (points == 0) continue;
+    std::string id = x.id;
+    std::replace(id.begin(), id.end(), '.', '-');
+    steps += fmt::format(
+        "    - name: {0}\n"
+        "      id: {1}\n"
+        "      uses: classroom-resources/autograding-command-grader@v1\n"
+        "      with:\n"
+        "        test-name: {0}\n"
+        "        setup-command: ''\n"
+        "        command: ./build/clothlab grade --exercise {0} --require-full\n"
+        "        timeout: 10\n"
+        "        max-score: {2}\n",
+        x.id, id, points);
+    std::string upper = id;
+    std::transform(upper.begin(), upper.end(), upper.begin(),
+                   [](unsigned char ch) { return static_cast<char>(std::toupper(ch)); });
+    env += fmt::format("        {}_RESULTS: \"${{{{steps.{}.outputs.result}}}}\"\n", upper, id);
+    runners += (runners.empty() ? "" : ",") + id;
+  }
+  return fmt::format(
+      "# GitHub Classroom autograding for clothlab, written by `clothlab grade --classroom PATH`\n"
+      "# from the grading tests' points: one step per exercise, worth its points when every case\n"
+      "# of the exercise passes. `./build/clothlab grade` shows a student the same cases.\n"
+      "name: Autograding Tests\n"
+      "'on':\n"
+      "  - push\n"
+      "  - workflow_dispatch\n"
+      "  - repository_dispatch\n"
+      "permissions:\n"
+      "  checks: write\n"
+      "  actions: read\n"
+      "  contents: read\n"
+      "jobs:\n"
+      "  run-autograding-tests:\n"
+      "    runs-on: ubuntu-latest\n"
+      "    if: github.actor != 'github-classroom[bot]'\n"
+      "    steps:\n"
+      "    - name: Checkout code\n"
+      "      uses: actions/checkout@v4\n"
+      "    - name: Install the packages\n"
+      "      run: sudo apt-get update && sudo apt-get install -y --no-install-recommends g++ "
+      "cmake\n"
+      "        make libeigen3-dev doctest-dev libfmt-dev libtomlplusplus-dev libcli11-dev\n"
+      "    - name: Build the grader\n"
+      "      run: cmake -S . -B build && cmake --build build --parallel 4 --target clothlab\n"
+      "        grade-student\n"
+      "{}"
+      "    - name: Autograding Reporter\n"
+      "      uses: classroom-resources/autograding-grader-reporter@v1\n"
+      "      env:\n"
+      "{}"
+      "      with:\n"
+      "        runners: {}\n",
+      steps, env, runners);
 }
 
 // --- The command --------------------------------------------------------------------------------
@@ -706,18 +704,48 @@ void print_points_table(const std::vector<Case>& cases) {
   std::size_t width = 4;
   for (const Case& c : cases)
     width = std::max(width, c.name.size());
-  fmt::print("{:<10} {:<{}} {:>6}\n", "Exercise", "Case", width, "Points");
-  int total = 0;
+  fmt::print("{:<10} {:<{}} {:>6}  {}\n", "Exercise", "Case", width, "Points", "Visibility");
+  int total = 0, hidden = 0;
   for (const Case& c : cases) {
-    fmt::print("{:<10} {:<{}} {:>6}\n", c.exercise, c.name, width, c.points);
+    fmt::print("{:<10} {:<{}} {:>6}  {}\n", c.exercise, c.name, width, c.points, c.visibility);
     total += c.points;
+    hidden += c.visibility == "visible" ? 0 : c.points;
   }
   fmt::print("\nTotal: {} points in {} cases\n", total, cases.size());
+  if (hidden > 0)
+    fmt::print("of which in hidden tests, not shown to students before the due date: {} points\n",
+               hidden);
+}
+
+// What the build of a submission took, left out and said, for the report.
+std::string submission_notes(const SubmissionBuild& b) {
+  auto names = [](const std::vector<std::string>& files) {
+    std::string s;
+    for (const std::string& f : files)
+      s += (s.empty() ? "" : ", ") + f;
+    return s;
+  };
+  std::string s;
+  if (!b.taken.empty()) s += "Graded from the submission: " + names(b.taken) + "\n";
+  if (!b.missing.empty())
+    s += "Not in the submission (graded on the shipped stub): " + names(b.missing) + "\n";
+  if (!b.ignored.empty()) s += "Ignored (not an exercise file): " + names(b.ignored) + "\n";
+  if (!b.built) s += "\nThe submission does not compile:\n" + indent(b.first_error, "  ") + "\n";
+  return s + "\n";
+}
+
+std::string default_scratch() {
+  return (fs::path(grade_kit_dir()).parent_path() / "grade-scratch").string();
 }
 
 void grade(const Options& o) {
-  const std::string binary = o.binary.empty() ? binary_for(o.impl) : o.binary;
+  const bool submission = !o.submission.empty();
+  std::string binary = submission         ? binary_for("stubs")
+                       : o.binary.empty() ? binary_for(o.impl)
+                                          : o.binary;
   if (!fs::exists(binary)) fail(2, binary + " does not exist");
+  // A submission's cases are listed by the shipped stubs' binary, built from the same grading
+  // tests: nothing of the submission runs outside the process of one case.
   std::vector<Case> cases = list_cases(binary);
   if (!o.exercise.empty()) {
     std::erase_if(cases, [&](const Case& c) { return !selected(c, o.exercise); });
@@ -725,6 +753,11 @@ void grade(const Options& o) {
   }
   if (o.list) {
     print_points_table(cases);
+    return;
+  }
+  if (!o.classroom.empty()) {
+    write_file(o.classroom, classroom_workflow(cases));
+    fmt::print("wrote {}\n", o.classroom);
     return;
   }
 
@@ -736,18 +769,49 @@ void grade(const Options& o) {
   InterruptGuard guard;
   const auto start = Clock::now();
   auto elapsed = [&] { return std::chrono::duration<double>(Clock::now() - start).count(); };
-  for (std::size_t i = 0; i < cases.size() && !g_interrupted; ++i) {
+  std::string notes;
+  bool compiled = true;
+  if (submission) {
+    notes = "Submission: " + o.submission + "\n";
+    write_reports(o, cases, elapsed(), notes);  // so even an interrupted build leaves results
+    if (colour) fmt::print("building {} ...", o.submission);
+    std::fflush(stdout);
+    SubmissionBuild build;
+    try {
+      build = build_submission(o.submission, o.scratch.empty() ? default_scratch() : o.scratch,
+                               o.build_timeout);
+    } catch (const std::exception& e) {
+      fail(2, e.what());
+    }
+    if (colour) fmt::print("\r\033[K");
+    notes += submission_notes(build);
+    fmt::print("{}", notes);
+    compiled = build.built;
+    if (compiled) {
+      binary = build.binary;
+    } else if (!g_interrupted) {
+      for (Case& c : cases) {
+        c.done = true;
+        c.not_compiled = true;
+        c.status = "not compiled";
+        c.message = "the submission does not compile:\n" + build.first_error;
+      }
+    }
+  }
+  for (std::size_t i = 0; compiled && i < cases.size() && !g_interrupted; ++i) {
     if (colour) fmt::print("\r\033[K[{}/{}] {}", i + 1, cases.size(), cases[i].name.substr(0, 70));
     std::fflush(stdout);
     run_case(binary, cases[i], o.timeout);
-    write_reports(o, cases, elapsed());  // after every case, so an interrupted run leaves results
+    // After every case, so an interrupted run leaves results.
+    write_reports(o, cases, elapsed(), notes);
   }
   if (colour) fmt::print("\r\033[K");
   std::fflush(stdout);
 
   fmt::print("{}", summary(cases, colour));
-  write_reports(o, cases, elapsed());
+  write_reports(o, cases, elapsed(), notes);
   if (g_interrupted) fail(130, "interrupted: the results of the cases run so far are written");
+  if (o.autolab) fmt::print("{}\n", autolab_line(cases));
 
   if (o.require_full) {
     const auto failed =
@@ -791,8 +855,23 @@ void add_grade_command(CLI::App& app) {
   cmd->add_flag("--require-full", o->require_full, "Exit with status 1 unless every case passed");
   cmd->add_flag("--require-zero", o->require_zero,
                 "Exit with status 1 unless every exercise scored zero");
-  cmd->add_option("--binary", o->binary, "Grade this doctest binary (built with grade_main.cpp)")
-      ->group("");
+  CLI::Option* binary = cmd->add_option("--binary", o->binary,
+                                        "Grade this doctest binary (built with grade_main.cpp)")
+                            ->group("");
+  cmd->add_option("--submission", o->submission,
+                  "Grade the exercise files in this folder (a student's submission), built in a "
+                  "scratch folder")
+      ->excludes(binary);
+  cmd->add_option("--scratch", o->scratch,
+                  "Where to build a submission (default: grade-scratch next to clothlab)");
+  cmd->add_option("--build-timeout", o->build_timeout,
+                  "Seconds configuring, then compiling, a submission may take")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
+  cmd->add_flag("--autolab", o->autolab,
+                "End with Autolab's one-line JSON summary of the scores per exercise");
+  cmd->add_option("--classroom", o->classroom,
+                  "Write a GitHub Classroom workflow (one step per exercise) here; grade nothing");
   cmd->callback([o] { grade(*o); });
 }
 

@@ -4,8 +4,11 @@
 // ctest discovery). `clothlab grade` runs it with --reporters=clothlab instead, which prints one
 // event per line, fields separated by tabs:
 //
-//   @clothlab  case       SUITE  NAME  FILE  LINE  POINTS     (--list-test-cases; POINTS is
-//                                                               empty without POINTS(n))
+//   @clothlab  case       SUITE  NAME  FILE  LINE  POINTS  VISIBILITY
+//                                                              (--list-test-cases; POINTS is
+//                                                               empty without POINTS(n), and
+//                                                               VISIBILITY without
+//                                                               POINTS_VISIBILITY(n, v))
 //   @clothlab  start      NAME
 //   @clothlab  fail       FILE  LINE  MACRO  EXPRESSION  VALUES  CONTEXT...
 //                                                              (FAIL("text"): EXPRESSION empty,
@@ -22,6 +25,7 @@
 #define DOCTEST_CONFIG_IMPLEMENT_WITH_MAIN
 #include <doctest/doctest.h>
 
+#include <cctype>
 #include <ostream>
 #include <sstream>
 #include <string>
@@ -52,16 +56,17 @@ std::string escape(const std::string& text) {
   return out;
 }
 
-// "points=3" -> "3"; empty when the description does not give points.
-std::string points_of(const char* description) {
+// The value of "key=" in a description ("points=3 visibility=hidden", key "points" -> "3"): the
+// letters, digits and underscores after it; empty when the description does not give it.
+std::string field_of(const char* description, const std::string& key) {
   const std::string d = description ? description : "";
-  const std::string key = "points=";
-  const auto at = d.find(key);
+  const auto at = d.find(key + "=");
   if (at == std::string::npos) return "";
-  std::string digits;
-  for (auto i = at + key.size(); i < d.size() && d[i] >= '0' && d[i] <= '9'; ++i)
-    digits += d[i];
-  return digits;
+  std::string value;
+  for (auto i = at + key.size() + 1;
+       i < d.size() && (std::isalnum(static_cast<unsigned char>(d[i])) || d[i] == '_'); ++i)
+    value += d[i];
+  return value;
 }
 
 // What a failed assertion found, in the words of doctest's console reporter.
@@ -117,7 +122,7 @@ struct ClothlabReporter : public doctest::IReporter {
       for (unsigned i = 0; i < in.num_data; ++i) {
         const doctest::TestCaseData& tc = *in.data[i];
         emit({"case", tc.m_test_suite, tc.m_name, tc.m_file.c_str(), std::to_string(tc.m_line),
-              points_of(tc.m_description)});
+              field_of(tc.m_description, "points"), field_of(tc.m_description, "visibility")});
       }
     } else if (opt.list_test_suites) {
       for (unsigned i = 0; i < in.num_data; ++i)

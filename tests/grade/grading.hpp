@@ -8,6 +8,10 @@
 //
 // The case name starts with the exercise ID; POINTS(n) is how many points it is worth. Case
 // names must not contain commas, '*' or '?' (doctest reads those as filter syntax).
+//
+// Hidden tests (tests/grade-hidden/, which the student release leaves out) are reported to
+// Gradescope as "after_due_date" unless a case says otherwise with
+// POINTS_VISIBILITY(n, hidden) (or visible, after_published, after_due_date).
 // Expectations are derived in a comment beside each check, and a grading test never calls
 // the solutions: it must hold for any correct answer.
 #pragma once
@@ -20,6 +24,8 @@
 #include "clothlab/types.hpp"
 
 #define POINTS(n) doctest::description("points=" #n)
+#define POINTS_VISIBILITY(n, visibility) \
+  doctest::description("points=" #n " visibility=" #visibility)
 
 namespace doctest {
 // Prints a Vec3 as (x, y, z) in a failed check, so the message shows the numbers.
