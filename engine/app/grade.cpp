@@ -684,6 +684,9 @@ std::string classroom_workflow(const std::vector<Case>& cases) {
 // --- The command --------------------------------------------------------------------------------
 
 std::string binary_for(const std::string& impl) {
+  if (impl == "reference" && !CLOTHLAB_HAVE_SOLUTIONS) {
+    fail(2, "this is a student release: it has no reference solutions to grade");
+  }
   // The grading binaries are built next to clothlab and clothlab-student.
   std::error_code ec;
   const fs::path self = fs::read_symlink("/proc/self/exe", ec);
