@@ -3,6 +3,7 @@
 viewer page in headless Chromium, saved as lessons/NN-name/picture.png.
 
     cmake --build build --target pictures      (or: python3 lessons/pictures.py build/clothlab)
+    python3 lessons/pictures.py build/clothlab 09-ropes-and-solids     (only the lessons named)
 """
 import os
 import shutil
@@ -20,14 +21,16 @@ PICTURES = {
     "06-plasticity-and-tearing": ("storm-flag.toml", 25),
     "07-integrators": ("pendulum-cloth.toml", 10),
     "08-stability": ("stiff-sheet-implicit.toml", -1),
+    "09-ropes-and-solids": ("jelly-cube.toml", 21),
 }
 
 
 def main():
-    if len(sys.argv) != 2:
+    if len(sys.argv) < 2 or any(name not in PICTURES for name in sys.argv[2:]):
         print(__doc__)
         return 2
     clothlab = os.path.abspath(sys.argv[1])
+    chosen = sys.argv[2:] or list(PICTURES)
     browser = shutil.which("chromium") or shutil.which("chromium-browser")
     if not browser:
         print("pictures: no chromium on this machine: sudo apt-get install -y chromium")
@@ -36,7 +39,8 @@ def main():
     root = os.path.dirname(lessons)
     work = tempfile.mkdtemp(prefix="clothlab-pictures-")
     try:
-        for lesson, (scene, frame) in PICTURES.items():
+        for lesson in chosen:
+            scene, frame = PICTURES[lesson]
             out = os.path.join(work, lesson)
             page = os.path.join(out, "view.html")
             # Run from the repository's root, so the page names the scene as lessons/...

@@ -15,6 +15,7 @@
 
 #include "clothlab/cloth.hpp"
 #include "clothlab/rope.hpp"
+#include "clothlab/solid.hpp"
 #include "clothlab/spring_damper.hpp"
 #include "clothlab/world.hpp"
 
@@ -50,6 +51,7 @@ struct Scene {
   // What the builders made, for the tables read after them (springs, bending, aerodynamics).
   std::optional<ClothGrid> cloth;
   std::optional<Rope> rope;
+  std::optional<SolidLattice> solid;
   SpringSet springs;  // structural, shear and one-by-one springs: the "springs" effect
 
   long step_count() const;  // steps needed to cover `duration`

@@ -15,6 +15,8 @@
 #include "clothlab/ground_collision.hpp"
 #include "clothlab/implicit_euler.hpp"
 #include "clothlab/plasticity.hpp"
+#include "clothlab/solid.hpp"
+#include "clothlab/strain_limiting.hpp"
 #include "clothlab/tearing.hpp"
 
 namespace clothlab {
@@ -191,6 +193,56 @@ void read_cloth(SceneTable& t, Scene& scene) {
   scene.world.triangles = grid_triangles(grid);
 }
 
+// [solid]: a box-shaped lattice of particles, a soft solid (lesson 09).
+void read_solid(SceneTable& t, Scene& scene) {
+  SolidSpec spec;
+  if (!t.has("particles")) {
+    t.fail("particles",
+           "[solid] has no 'particles'; expected particles = [nx, ny, nz], whole "
+           "numbers from 2 to 1000 (particles along x, y and z)");
+  }
+  const std::vector<long> n = t.integer_list("particles", 2, 1000, "particle count");
+  if (n.size() != 3) {
+    t.fail("particles", fmt::format("'particles' in [solid] has {} elements; expected [nx, ny, "
+                                    "nz], three whole numbers from 2 to 1000",
+                                    n.size()));
+  }
+  spec.nx = n[0], spec.ny = n[1], spec.nz = n[2];
+  if (spec.nx * spec.ny * spec.nz > kMaxClothParticles) {
+    t.fail("particles",
+           fmt::format("[solid] of {} x {} x {} is {} particles; expected at most {} "
+                       "(nx ny nz)",
+                       spec.nx, spec.ny, spec.nz, spec.nx * spec.ny * spec.nz, kMaxClothParticles));
+  }
+  spec.size = t.required_vec3("size", "m");
+  if (!(spec.size.array() > 0.0).all()) {
+    t.fail("size", fmt::format("'size' in [solid] is ({}, {}, {}) m; expected three edge lengths "
+                               "> 0 [m]",
+                               spec.size.x(), spec.size.y(), spec.size.z()));
+  }
+  spec.corner = t.vec3("corner", "m", Vec3::Zero());
+  spec.mass = t.required_number("mass", Range::positive("kg"));
+  const Index count = spec.nx * spec.ny * spec.nz;
+  check_particle_mass(
+      t, "mass", spec.mass / static_cast<double>(count),
+      fmt::format("the solid's mass of {} kg shared by {} particles", spec.mass, count));
+  Particles& p = scene.world.particles;
+  const SolidLattice lattice = add_solid(p, spec);
+  // The box lies between its lowest corner and the opposite one.
+  check_within_guard(t, "corner", scene, lattice.first, "the solid's first particle");
+  check_within_guard(t, "size", scene, lattice.first + lattice.size() - 1,
+                     "the solid's last particle");
+  const auto named = [&](std::string_view name, std::vector<Index>& out) {
+    return named_solid_pins(lattice, name, out);
+  };
+  for (Index i : read_pins(t, lattice.size(), named, "top-face, bottom-face, none"))
+    pin(p, lattice.first + i);
+  scene.solid = lattice;
+  // Its outside, for the viewer and mesh files, after any cloth's triangles.
+  const std::vector<Triangle> surface = solid_surface_triangles(lattice);
+  scene.world.triangles.insert(scene.world.triangles.end(), surface.begin(), surface.end());
+}
+
 // [[spring]]: one spring-damper between two particles given by index (lesson 02).
 void read_spring(SceneTable& t, Scene& scene) {
   const Particles& p = scene.world.particles;
@@ -207,11 +259,12 @@ void read_spring(SceneTable& t, Scene& scene) {
   scene.springs.add(i, j, ks, kd, l0, p.x);
 }
 
-// [springs]: structural and shear springs of the cloth, or the rope's springs (lesson 02).
+// [springs]: structural and shear springs of the cloth, the rope's springs (lesson 02), the
+// solid's edges and diagonals (lesson 09).
 void read_springs(SceneTable& t, Scene& scene) {
-  if (!scene.cloth && !scene.rope) {
+  if (!scene.cloth && !scene.rope && !scene.solid) {
     t.fail("ks",
-           "[springs] has nothing to connect; expected a [cloth] or a [rope] (springs "
+           "[springs] has nothing to connect; expected a [cloth], a [rope] or a [solid] (springs "
            "between single particles are [[spring]] tables)");
   }
   const double ks = t.required_number("ks", Range::non_negative("N/m"));
@@ -225,6 +278,16 @@ void read_springs(SceneTable& t, Scene& scene) {
     const ClothGrid& g = *scene.cloth;
     add_spring_family(scene.springs, structural_pairs(g.rows, g.cols), g.first, ks, kd, x);
     add_spring_family(scene.springs, shear_pairs(g.rows, g.cols), g.first, shear_ks, shear_kd, x);
+  }
+  if (scene.solid) {
+    // The cell's edges take ks and kd; both kinds of diagonal resist shear, and take the shear
+    // constants, as the cloth's diagonals do.
+    const SolidLattice& g = *scene.solid;
+    add_spring_family(scene.springs, solid_structural_pairs(g.nx, g.ny, g.nz), g.first, ks, kd, x);
+    add_spring_family(scene.springs, solid_face_diagonal_pairs(g.nx, g.ny, g.nz), g.first, shear_ks,
+                      shear_kd, x);
+    add_spring_family(scene.springs, solid_body_diagonal_pairs(g.nx, g.ny, g.nz), g.first, shear_ks,
+                      shear_kd, x);
   }
 }
 
@@ -306,6 +369,21 @@ ContactMaterial read_material(SceneTable& t) {
                                m.mu_d, m.mu_s));
   }
   return m;
+}
+
+// [strain_limit]: springs shortened back to a largest strain after each step (lesson 09).
+void read_strain_limit(SceneTable& t, Scene& scene) {
+  if (scene.springs.size() == 0) {
+    t.fail("max_strain",
+           "[strain_limit] has no springs to limit; expected [springs] or [[spring]] tables");
+  }
+  StrainLimits limits;
+  limits.max_strain = t.required_number("max_strain", Range::non_negative(""));
+  limits.max_compression =
+      t.number("max_compression", Range{0.0, 1.0, false, ""}, limits.max_compression);
+  const long iterations = t.integer("iterations", 1, 10000, 10);
+  scene.world.post_step_effects.push_back(
+      std::make_unique<StrainLimiting>(limits, static_cast<int>(iterations)));
 }
 
 // [ground]: the plane y = y0, solid below (lesson 05).
@@ -422,6 +500,8 @@ constexpr std::array kKinds = {
                    "[rope] with start, end, particles and mass", read_rope},
     SceneTableKind{"cloth", false, false, "rows cols spacing origin plane mass density pins",
                    "[cloth] with rows, cols, spacing and mass", read_cloth},
+    SceneTableKind{"solid", false, false, "particles size corner mass pins",
+                   "[solid] with particles, size and mass", read_solid},
     SceneTableKind{"spring", true, false, "i j ks kd l0", "[[spring]] with i, j and ks",
                    read_spring},
     SceneTableKind{"springs", false, false, "ks kd shear_ks shear_kd", "[springs] with ks",
@@ -435,6 +515,9 @@ constexpr std::array kKinds = {
     SceneTableKind{"drag", false, false, "rho cd area wind", "[drag] with area", read_drag},
     SceneTableKind{"buoyancy", false, false, "rho volume surface g", "[buoyancy] with volume",
                    read_buoyancy},
+    // Before the colliders, so that a contact has the last word on where a particle ends up.
+    SceneTableKind{"strain_limit", false, false, "max_strain max_compression iterations",
+                   "[strain_limit] with max_strain", read_strain_limit},
     SceneTableKind{"ground", false, false, "y e mu_s mu_d rest_speed model friction",
                    "[ground] with y, e, mu_s and mu_d", read_ground},
     SceneTableKind{"sphere", false, false, "centre radius e mu_s mu_d rest_speed",
@@ -472,7 +555,9 @@ std::string scene_table_names() {
 
 void finish_scene(Scene& scene, const std::function<void(const std::string&)>& fail) {
   if (scene.world.particles.size() == 0) {
-    fail("the scene has no particles; expected [[particle]] tables, a [rope] or a [cloth]");
+    fail(
+        "the scene has no particles; expected [[particle]] tables, a [rope], a [cloth] or a "
+        "[solid]");
   }
   // Structural, shear and one-by-one springs make one effect, built once all are known.
   if (scene.springs.size() > 0) {

@@ -304,13 +304,45 @@ TEST_CASE("scene error: a velocity beyond the guard's max_speed") {
   check_bad_scene("velocity_beyond_guard.toml");
 }
 
+// Strain limiting and soft solids (lesson 09).
+TEST_CASE("scene error: strain limiting without springs") {
+  check_bad_scene("strain_limit_without_springs.toml");
+}
+TEST_CASE("scene error: a negative largest strain") {
+  check_bad_scene("negative_max_strain.toml");
+}
+TEST_CASE("scene error: a largest compression above 1") {
+  check_bad_scene("max_compression_above_one.toml");
+}
+TEST_CASE("scene error: strain limiting with 0 sweeps") {
+  check_bad_scene("zero_strain_iterations.toml");
+}
+TEST_CASE("scene error: a misspelt key in [strain_limit]") {
+  check_bad_scene("strain_limit_unknown_key.toml");
+}
+TEST_CASE("scene error: a solid one particle thick") {
+  check_bad_scene("solid_flat.toml");
+}
+TEST_CASE("scene error: a solid with two particle counts") {
+  check_bad_scene("solid_two_counts.toml");
+}
+TEST_CASE("scene error: a solid without its particle counts") {
+  check_bad_scene("solid_without_particles.toml");
+}
+TEST_CASE("scene error: a solid of zero height") {
+  check_bad_scene("solid_zero_size.toml");
+}
+TEST_CASE("scene error: an unknown solid pin set") {
+  check_bad_scene("solid_unknown_pin_set.toml");
+}
+
 TEST_CASE("scene error: every bad scene file has a test case") {
   // A file added to tests/scenes/bad/ without a test above would never be checked.
   int files = 0;
   for (const auto& entry : fs::directory_iterator(fs::path(CLOTHLAB_TEST_SCENES) / "bad")) {
     if (entry.path().extension() == ".toml") ++files;
   }
-  CHECK(files == 81);
+  CHECK(files == 91);
 }
 
 TEST_CASE("scene error: a missing file") {
