@@ -78,9 +78,10 @@ endif()
 
 # --- Gradescope ---------------------------------------------------------------------------------
 file(WRITE ${OUT}/setup.sh [=[#!/usr/bin/env bash
-# Gradescope runs this once, as root, when it builds the autograder's image (Debian or Ubuntu):
-# it installs the packages clothlab needs and builds the engine, the grading tests and the
-# grader. Each submission then compiles only its exercise files (see run_autograder).
+# Gradescope runs this once, as root, when it builds the autograder's image: it installs the
+# packages clothlab needs and builds the engine, the grading tests and the grader. Each
+# submission then compiles only its exercise files (see run_autograder). Choose a Debian 12 or
+# Ubuntu 24.04 (or later) base image: Ubuntu 22.04 has no libtomlplusplus-dev.
 set -euo pipefail
 export DEBIAN_FRONTEND=noninteractive
 root=${AUTOGRADER_ROOT:-/autograder}
