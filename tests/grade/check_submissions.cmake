@@ -42,12 +42,17 @@ if(crashed EQUAL 0 OR hung EQUAL 0 OR ex01 EQUAL 0)
   message(FATAL_ERROR "the cases this test plants faults in are not in the table:\n${table}")
 endif()
 
-file(GLOB exercises_before ${SOURCE}/exercises/*.cpp)
-set(sums_before "")
-foreach(f ${exercises_before})
-  file(SHA256 ${f} sum)
-  list(APPEND sums_before ${sum})
-endforeach()
+# The names and SHA-256 sums of the user's exercise files, to check they are never touched.
+function(exercise_sums var)
+  file(GLOB files ${SOURCE}/exercises/*)
+  set(sums "")
+  foreach(f ${files})
+    file(SHA256 ${f} sum)
+    list(APPEND sums "${f}=${sum}")
+  endforeach()
+  set(${var} "${sums}" PARENT_SCOPE)
+endfunction()
+exercise_sums(sums_before)
 
 # grade_submission(NAME EXPECTED_SCORE ARGS...): grades WORK_DIR/NAME, checks results.json's
 # score, and leaves the output in out_NAME and the results in json_NAME.
@@ -178,13 +183,8 @@ if(NOT status MATCHES "^failed\\|visible\\|not compiled\nthe submission does not
 endif()
 
 # --- the user's tree ---------------------------------------------------------------------------
-file(GLOB exercises_after ${SOURCE}/exercises/*.cpp)
-set(sums_after "")
-foreach(f ${exercises_after})
-  file(SHA256 ${f} sum)
-  list(APPEND sums_after ${sum})
-endforeach()
-if(NOT exercises_before STREQUAL exercises_after OR NOT sums_before STREQUAL sums_after)
+exercise_sums(sums_after)
+if(NOT sums_before STREQUAL sums_after)
   problem("the user's exercises/ changed while grading submissions")
 endif()
 
