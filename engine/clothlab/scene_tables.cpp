@@ -15,6 +15,7 @@
 #include "clothlab/ground_collision.hpp"
 #include "clothlab/implicit_euler.hpp"
 #include "clothlab/plasticity.hpp"
+#include "clothlab/self_collision.hpp"
 #include "clothlab/solid.hpp"
 #include "clothlab/strain_limiting.hpp"
 #include "clothlab/tearing.hpp"
@@ -386,6 +387,34 @@ void read_strain_limit(SceneTable& t, Scene& scene) {
       std::make_unique<StrainLimiting>(limits, static_cast<int>(iterations)));
 }
 
+// The most cells of edge `thickness` along each axis of the guard's box, |x| <= max_position:
+// cell coordinates up to 1e15 fit easily in 64-bit integers (about 9.2e18).
+constexpr double kMaxCellsAcross = 1e15;
+
+// [self_collision]: particles kept `thickness` apart from each other (lesson 10).
+void read_self_collision(SceneTable& t, Scene& scene) {
+  SelfContact c;
+  c.thickness = t.required_number("thickness", Range::positive("m"));
+  const double bound = scene.world.guard.max_position;
+  if (bound / c.thickness > kMaxCellsAcross) {
+    t.fail("thickness",
+           fmt::format("thickness = {} m makes {:.3g} cells across the guard's max_position = {} "
+                       "m; expected thickness >= {:.3g} m (or a smaller max_position in [guard])",
+                       c.thickness, bound / c.thickness, bound, bound / kMaxCellsAcross));
+  }
+  c.e = t.number("e", Range{0.0, 1.0, false, ""}, c.e);
+  c.mu_s = t.number("mu_s", Range::non_negative(""), c.mu_s);
+  c.mu_d = t.number("mu_d", Range::non_negative(""), std::min(c.mu_d, c.mu_s));
+  if (c.mu_d > c.mu_s) {
+    t.fail("mu_d", fmt::format("mu_d = {} is larger than mu_s = {}; expected mu_d <= mu_s (sliding "
+                               "never grips harder than sticking)",
+                               c.mu_d, c.mu_s));
+  }
+  const long iterations = t.integer("iterations", 1, 1000, 4);
+  scene.world.post_step_effects.push_back(
+      std::make_unique<SelfCollision>(c, static_cast<int>(iterations), scene.world.particles.x));
+}
+
 // [ground]: the plane y = y0, solid below (lesson 05).
 void read_ground(SceneTable& t, Scene& scene) {
   const double y0 = t.number("y", Range::any("m"), 0.0);
@@ -518,6 +547,8 @@ constexpr std::array kKinds = {
     // Before the colliders, so that a contact has the last word on where a particle ends up.
     SceneTableKind{"strain_limit", false, false, "max_strain max_compression iterations",
                    "[strain_limit] with max_strain", read_strain_limit},
+    SceneTableKind{"self_collision", false, false, "thickness e mu_s mu_d iterations",
+                   "[self_collision] with thickness", read_self_collision},
     SceneTableKind{"ground", false, false, "y e mu_s mu_d rest_speed model friction",
                    "[ground] with y, e, mu_s and mu_d", read_ground},
     SceneTableKind{"sphere", false, false, "centre radius e mu_s mu_d rest_speed",

@@ -336,13 +336,33 @@ TEST_CASE("scene error: an unknown solid pin set") {
   check_bad_scene("solid_unknown_pin_set.toml");
 }
 
+// Self-collision (lesson 10).
+TEST_CASE("scene error: self-collision without a thickness") {
+  check_bad_scene("self_collision_without_thickness.toml");
+}
+TEST_CASE("scene error: a self-collision thickness of zero") {
+  check_bad_scene("zero_thickness.toml");
+}
+TEST_CASE("scene error: a self-collision thickness too small for the guard's box") {
+  check_bad_scene("self_collision_thickness_too_small.toml");
+}
+TEST_CASE("scene error: a self-collision restitution above 1") {
+  check_bad_scene("self_collision_restitution_above_one.toml");
+}
+TEST_CASE("scene error: self-collision with 0 passes") {
+  check_bad_scene("zero_self_collision_iterations.toml");
+}
+TEST_CASE("scene error: a misspelt key in [self_collision]") {
+  check_bad_scene("self_collision_unknown_key.toml");
+}
+
 TEST_CASE("scene error: every bad scene file has a test case") {
   // A file added to tests/scenes/bad/ without a test above would never be checked.
   int files = 0;
   for (const auto& entry : fs::directory_iterator(fs::path(CLOTHLAB_TEST_SCENES) / "bad")) {
     if (entry.path().extension() == ".toml") ++files;
   }
-  CHECK(files == 91);
+  CHECK(files == 97);
 }
 
 TEST_CASE("scene error: a missing file") {

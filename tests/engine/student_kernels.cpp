@@ -1,0 +1,51 @@
+// The engine runs the exercise kernels of the build it is linked with: the reference build runs
+// solutions/, the student build exercises/. This binary is linked with the shipped stubs (which
+// tests/grade regenerates from exercises/), so wherever the engine calls a kernel it must stop
+// with that exercise's NotImplemented: proof that a student's scene runs the student's code.
+#include <doctest/doctest.h>
+
+#include <string>
+
+#include "clothlab/not_implemented.hpp"
+#include "clothlab/scene.hpp"
+#include "clothlab/self_collision.hpp"
+
+namespace {
+
+// Which exercise `run` stops at, or "" if it runs through.
+template <class F>
+std::string stops_at(F&& run) {
+  try {
+    run();
+  } catch (const clothlab::NotImplemented& e) {
+    return e.exercise();
+  }
+  return "";
+}
+
+}  // namespace
+
+TEST_CASE("student build: [self_collision] calls the student's hash kernel (ex10.1)") {
+  clothlab::Scene scene = clothlab::parse_scene(R"(
+[[particle]]
+position = [0.0, 0.0, 0.0]
+mass = 1.0
+[[particle]]
+position = [0.0, 0.1, 0.0]
+mass = 1.0
+[self_collision]
+thickness = 0.05
+[integrator]
+dt = 0.001
+duration = 1
+)",
+                                                "stubs.toml");
+  clothlab::World& w = scene.world;
+  REQUIRE(w.post_step_effects.size() == 1);
+  auto* effect = dynamic_cast<clothlab::SelfCollision*>(w.post_step_effects[0].get());
+  REQUIRE(effect != nullptr);
+  // The effect's own step, as World::step calls it after the integrator (whose kernels are
+  // stubs too, so the step itself would stop at lesson 01).
+  CHECK(stops_at([&] { effect->apply(w, scene.dt); }) == "ex10.1");
+  CHECK(stops_at([&] { effect->detect(w.particles.x, 1e6); }) == "ex10.1");
+}
