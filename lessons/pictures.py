@@ -22,6 +22,7 @@ PICTURES = {
     "07-integrators": ("pendulum-cloth.toml", 10),
     "08-stability": ("stiff-sheet-implicit.toml", -1),
     "09-ropes-and-solids": ("jelly-cube.toml", 21),
+    "11-game-loop": ("banner.toml", 240),
 }
 
 
