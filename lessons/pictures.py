@@ -23,6 +23,7 @@ PICTURES = {
     "08-stability": ("stiff-sheet-implicit.toml", -1),
     "09-ropes-and-solids": ("jelly-cube.toml", 21),
     "10-collision-detection": ("towel-on-a-line.toml", 50),
+    "11-game-loop": ("banner.toml", 240),
 }
 
 

@@ -45,6 +45,7 @@ class Aerodynamics final : public ForceEffect {
                   Matrix3X& f) const override;
   // Wind may change while the simulation runs (a gust, a game's weather).
   void set_wind(const Vec3& v_air) { v_air_ = v_air; }
+  const Vec3& wind() const { return v_air_; }  // [m/s]
   // 1/2 M |wind|^2: the kinetic energy of particles carried along at the wind's speed.
   double energy_scale(const Particles& p, const Matrix3X& /*x*/, double /*size*/) const override {
     return 0.5 * p.m.sum() * v_air_.squaredNorm();

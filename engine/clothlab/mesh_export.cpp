@@ -32,7 +32,13 @@ std::vector<SpringView> all_springs(const World& world) {
 }  // namespace
 
 Matrix3X vertex_normals(const Matrix3X& x, const std::vector<Triangle>& triangles) {
-  Matrix3X normals = Matrix3X::Zero(3, x.cols());
+  Matrix3X normals;
+  vertex_normals(x, triangles, normals);
+  return normals;
+}
+
+void vertex_normals(const Matrix3X& x, const std::vector<Triangle>& triangles, Matrix3X& normals) {
+  normals.setZero(3, x.cols());
   for (const Triangle& t : triangles) {
     const Vec3 n_star = (x.col(t[1]) - x.col(t[0])).cross(x.col(t[2]) - x.col(t[0]));
     for (Index i : t)
@@ -42,7 +48,6 @@ Matrix3X vertex_normals(const Matrix3X& x, const std::vector<Triangle>& triangle
     const double length = normals.col(i).norm();
     if (length > 0.0) normals.col(i) /= length;
   }
-  return normals;
 }
 
 MeshExporter::MeshExporter(const std::filesystem::path& dir, bool obj, bool vtk)
