@@ -1,4 +1,5 @@
-// bench.cpp: `clothlab bench boundary` and `clothlab bench accuracy`.
+// bench.cpp: `clothlab bench boundary` and `clothlab bench accuracy` (`bench speed` is in
+// bench_speed.cpp).
 //
 // bench boundary:
 // The engine's hot loops call the exercise kernels (gravity_force, symplectic_euler_step), which
@@ -284,6 +285,8 @@ void add_bench_command(CLI::App& app) {
   boundary->add_option("--repeats", repeats, "Repeats (median is shown)")
       ->check(CLI::PositiveNumber);
   boundary->callback([] { bench_boundary(n, steps, repeats); });
+
+  add_bench_speed_command(*bench);
 
   static AccuracyOptions accuracy_options;
   AccuracyOptions& a = accuracy_options;

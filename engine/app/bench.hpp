@@ -5,4 +5,5 @@
 
 namespace clothlab::app {
 void add_bench_command(CLI::App& app);
+void add_bench_speed_command(CLI::App& bench);  // bench_speed.cpp
 }  // namespace clothlab::app

@@ -1,10 +1,11 @@
 // clothlab: the command line.
 //
 //   clothlab                          run the built-in demo scene
-//   clothlab run SCENE.toml [--out D] simulate a scene and write its frames
+//   clothlab run SCENE.toml [--out D] simulate a scene and write its frames (--threads N)
 //   clothlab validate SCENE.toml      check a scene without running it
 //   clothlab grade [...]              grade the exercises (see grade.cpp)
 //   clothlab bench boundary           measure what the exercise boundary costs
+//   clothlab bench speed              the engine's speed on cloths of 32^2 to 256^2 particles
 //
 // The same code builds `clothlab` (reference solutions) and `clothlab-student` (your
 // exercises); app::kKernels says which.
@@ -182,6 +183,12 @@ int main(int argc, char** argv) {
   run_cmd->add_flag("--obj", obj, "Also write an OBJ sequence to <output folder>/frames/");
   run_cmd->add_flag("--vtk", vtk, "Also write a VTK series to <output folder>/frames/");
   run_cmd->add_flag("--stats", stats, "Print the time spent in each effect of the scene");
+  int threads = -1;
+  run_cmd
+      ->add_option("--threads", threads,
+                   "Threads a step may use (default: [engine] threads in the scene, or 1; 0: "
+                   "every core). The result does not depend on it")
+      ->check(CLI::Range(0, 1024));
 
   std::string validate_path;
   CLI::App* validate_cmd = app.add_subcommand("validate", "Check a scene without running it");
@@ -205,6 +212,8 @@ int main(int argc, char** argv) {
       if (no_html) outputs.html.clear();
       outputs.obj = obj;
       outputs.vtk = vtk;
+      if (threads >= 0)
+        scene.world.threads = threads > 0 ? threads : ThreadTeam::hardware_threads();
       return run(scene, outputs, stats);
     }
     if (*validate_cmd) {

@@ -20,6 +20,12 @@ void FluidDrag::add_forces(const Particles& p, const Matrix3X& /*x*/, const Matr
     f.col(i) += fluid_drag_force(v.col(i), v_air_, rho_, cd_, area_);
 }
 
+void FluidDrag::add_forces_soa(const Particles& /*p*/, const SoA3& /*x*/, const SoA3& v, SoA3& f,
+                               ThreadTeam* /*team*/) const {
+  for (Index i = 0; i < f.cols(); ++i)
+    f.col(i) += fluid_drag_force(v.col(i), v_air_, rho_, cd_, area_);
+}
+
 void Buoyancy::add_forces(const Particles& p, const Matrix3X& x, const Matrix3X& /*v*/,
                           Matrix3X& f) const {
   const double lift = rho_ * volume_ * g_;  // weight of the displaced fluid [N]

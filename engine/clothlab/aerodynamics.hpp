@@ -75,6 +75,10 @@ class FluidDrag final : public ForceEffect {
   double energy_scale(const Particles& p, const Matrix3X& /*x*/, double /*size*/) const override {
     return 0.5 * p.m.sum() * v_air_.squaredNorm();
   }
+  // The fast path (fast_forces.hpp): the same force on the structure-of-arrays state.
+  bool adds_soa(const Particles& /*p*/) const override { return true; }
+  void add_forces_soa(const Particles& p, const SoA3& x, const SoA3& v, SoA3& f,
+                      ThreadTeam* team) const override;
 
  private:
   double rho_;   // fluid density [kg/m^3]

@@ -35,6 +35,14 @@ class ForceJacobians {
   virtual void add_self(Index i, const Mat3& dfdx, const Mat3& dfdv) = 0;
 };
 
+// Per-particle vectors stored as a structure of arrays for the fast path (fast_forces.hpp): the
+// x components of every particle, then the y components, then the z components, each row
+// contiguous. Column i is still particle i (s.col(i) is a Vec3 expression), but a loop over
+// particles reads each component in memory order, which lets the compiler vectorise it.
+using SoA3 = Eigen::Matrix<double, 3, Eigen::Dynamic, Eigen::RowMajor>;
+
+class ThreadTeam;
+
 class ForceEffect {
  public:
   virtual ~ForceEffect() = default;
@@ -77,6 +85,17 @@ class ForceEffect {
                              ForceJacobians& /*jacobians*/) const {
     return false;
   }
+
+  // The fast path (fast_forces.hpp). An effect that can add its forces on the structure-of-
+  // arrays copy of the state says so here, and may update what it caches for it (called once
+  // per evaluation, on one thread). The others make the world take the readable path.
+  virtual bool adds_soa(const Particles& /*p*/) const { return false; }
+
+  // The same forces as add_forces, added into f, with the same floating-point operations on
+  // each particle in the same order, so that the two paths agree bit for bit. `team` (null for
+  // one thread) may share the work; the result must not depend on how many threads it has.
+  virtual void add_forces_soa(const Particles& /*p*/, const SoA3& /*x*/, const SoA3& /*v*/,
+                              SoA3& /*f*/, ThreadTeam* /*team*/) const {}
 };
 
 class PostStepEffect {

@@ -21,12 +21,18 @@ void euler_advance(World& world, double dt, Kernel kernel) {
 
 }  // namespace
 
+// The kernels are passed wrapped in lambdas, not as function pointers: a lambda is a type of its
+// own, so each loop is compiled for its kernel and the kernel inlined into it at link time.
 void ExplicitEuler::advance(World& world, double dt) {
-  euler_advance(world, dt, explicit_euler_step);
+  euler_advance(world, dt, [](const Vec3& r, const Vec3& v, const Vec3& f, double inv_m, double h) {
+    return explicit_euler_step(r, v, f, inv_m, h);
+  });
 }
 
 void SymplecticEuler::advance(World& world, double dt) {
-  euler_advance(world, dt, symplectic_euler_step);
+  euler_advance(world, dt, [](const Vec3& r, const Vec3& v, const Vec3& f, double inv_m, double h) {
+    return symplectic_euler_step(r, v, f, inv_m, h);
+  });
 }
 
 }  // namespace clothlab

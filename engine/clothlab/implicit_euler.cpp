@@ -1,5 +1,7 @@
 #include "clothlab/implicit_euler.hpp"
 
+#include <chrono>
+
 #include <Eigen/IterativeLinearSolvers>
 #include <algorithm>
 
@@ -83,6 +85,8 @@ void ImplicitEuler::advance(World& world, double dt) {
   Particles& p = world.particles;
   const Index n = p.size();
 
+  using Clock = std::chrono::steady_clock;
+  const Clock::time_point start = Clock::now();
   // f0 = f(x, v), and the Jacobians at the same state.
   world.compute_forces(p.x, p.v, p.f);
   blocks_.clear();
@@ -122,6 +126,7 @@ void ImplicitEuler::advance(World& world, double dt) {
     if (pinned_[i]) b.col(i).setZero();
   }
 
+  const Clock::time_point assembled = Clock::now();
   Eigen::ConjugateGradient<Eigen::SparseMatrix<double>, Eigen::Lower | Eigen::Upper> solver;
   solver.setTolerance(tolerance);
   solver.setMaxIterations(max_iterations);
@@ -141,6 +146,9 @@ void ImplicitEuler::advance(World& world, double dt) {
   stats_.max_iterations = std::max(stats_.max_iterations, taken);
   stats_.worst_error = std::max(stats_.worst_error, solver.error());
   if (solver.info() != Eigen::Success) ++stats_.unconverged;
+  const Clock::time_point solved = Clock::now();
+  stats_.assembly_seconds += std::chrono::duration<double>(assembled - start).count();
+  stats_.solve_seconds += std::chrono::duration<double>(solved - assembled).count();
 
   // v' = v + dv, x' = x + dt v'.
   p.v += Eigen::Map<const Matrix3X>(last_dv_.data(), 3, n);

@@ -36,11 +36,13 @@ namespace clothlab {
 
 // What the linear solves of a run cost, for `clothlab run --stats` and the benchmark.
 struct LinearSolveStats {
-  long solves = 0;           // one per step
-  long iterations = 0;       // conjugate-gradient iterations over all solves
-  long max_iterations = 0;   // the most one solve took
-  long unconverged = 0;      // solves that stopped at max_iterations above the tolerance
-  double worst_error = 0.0;  // the largest relative residual a solve ended with
+  long solves = 0;                // one per step
+  long iterations = 0;            // conjugate-gradient iterations over all solves
+  long max_iterations = 0;        // the most one solve took
+  long unconverged = 0;           // solves that stopped at max_iterations above the tolerance
+  double worst_error = 0.0;       // the largest relative residual a solve ended with
+  double assembly_seconds = 0.0;  // [s] wall time computing f0, the Jacobians and filling A, b
+  double solve_seconds = 0.0;     // [s] wall time in conjugate gradients
 };
 
 class ImplicitEuler final : public Integrator {

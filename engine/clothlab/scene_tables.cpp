@@ -518,6 +518,13 @@ void read_guard(SceneTable& t, Scene& scene) {
       t.number("max_energy_growth", Range::positive(""), guard.max_energy_growth);
 }
 
+// [engine]: how the engine runs the scene (the physics does not depend on it).
+void read_engine(SceneTable& t, Scene& scene) {
+  World& world = scene.world;
+  world.threads = static_cast<int>(t.integer("threads", 1, 1024, world.threads));
+  world.fast_path = t.boolean("fast_path", world.fast_path);
+}
+
 // The order here is the order of reading: the guard's bounds, which the particles must start
 // within, then whatever creates particles, then the effects on them.
 constexpr std::array kKinds = {
@@ -560,6 +567,8 @@ constexpr std::array kKinds = {
     SceneTableKind{"integrator", false, true, "method dt duration tolerance max_iterations",
                    "[integrator] with method, dt [s] and duration [s]", read_integrator},
     SceneTableKind{"output", false, false, "fps", "[output] with fps", read_output},
+    SceneTableKind{"engine", false, false, "threads fast_path", "[engine] with threads",
+                   read_engine},
 };
 
 }  // namespace

@@ -1,7 +1,10 @@
 #include "clothlab/spring_damper.hpp"
 
 #include <algorithm>
+#include <atomic>
+#include <cassert>
 
+#include "clothlab/threads.hpp"
 #include "clothlab/world.hpp"
 
 namespace clothlab {
@@ -13,6 +16,7 @@ void SpringSet::add(Index a, Index b, double ks_ab, double kd_ab, double l0_ab, 
   kd.push_back(kd_ab);
   l0.push_back(l0_ab >= 0.0 ? l0_ab : (x.col(b) - x.col(a)).norm());
   l_built.push_back(l0.back());
+  changed();
 }
 
 void SpringSet::erase(const std::vector<size_t>& positions) {
@@ -35,11 +39,41 @@ void SpringSet::erase(const std::vector<size_t>& positions) {
     column->resize(kept);
   i.resize(kept);
   j.resize(kept);
+  changed();
+}
+
+void SpringSet::changed() {
+  // One counter for every set: two sets never share a generation unless one is a copy of the
+  // other (and then their i and j are the same too).
+  static std::atomic<unsigned long> changes{0};
+  generation = ++changes;
+}
+
+std::vector<SpringRun> spring_runs(const SpringSet& s) {
+  std::vector<SpringRun> runs;
+  for (size_t k = 0; k < s.size(); ++k) {
+    // Spring k continues the last run if it joins the particles just after its last spring's.
+    if (!runs.empty()) {
+      SpringRun& last = runs.back();
+      if (s.i[k] == last.i0 + last.length && s.j[k] == last.j0 + last.length) {
+        ++last.length;
+        continue;
+      }
+    }
+    runs.push_back({k, s.i[k], s.j[k], 1});
+  }
+  return runs;
 }
 
 void add_spring_family(SpringSet& springs, const std::vector<std::pair<Index, Index>>& pairs,
                        Index first, double ks, double kd, const Matrix3X& x) {
-  for (const auto& [a, b] : pairs)
+  // Sorted by direction b - a, then by a: springs with the same direction and consecutive first
+  // ends follow each other, which is what a run is (the order of the pairs matters nowhere else).
+  std::vector<std::pair<Index, Index>> sorted = pairs;
+  std::stable_sort(sorted.begin(), sorted.end(), [](const auto& p, const auto& q) {
+    return std::pair(p.second - p.first, p.first) < std::pair(q.second - q.first, q.first);
+  });
+  for (const auto& [a, b] : sorted)
     springs.add(first + a, first + b, ks, kd, -1.0, x);
 }
 
@@ -60,6 +94,122 @@ void SpringDampers::add_forces(const Particles& /*p*/, const Matrix3X& x, const 
     f.col(a) += f1;  // f2 = -f1: what pulls one end pushes the other
     f.col(b) -= f1;
   }
+}
+
+// --- The fast path -------------------------------------------------------------------------
+//
+// add_forces above is the lecture's loop: for each spring, f1 from the exercise kernel, added to
+// one end and subtracted from the other. It reads i[k] and j[k] and jumps to wherever they point,
+// so the compiler must take one spring at a time. The fast path computes the same f1 with the
+// same kernel, but run by run (see SpringRun): along a run both ends move one particle at a
+// time, and in the structure-of-arrays layout every input of spring t + 1 sits just after that
+// of spring t. The compiler then evaluates the kernel (inlined at link time) on four springs at
+// once. A run is taken in chunks of kChunk springs:
+//
+//   1. f1 of the chunk's springs into a small buffer (it stays in the processor's nearest cache);
+//   2. the chunk's upper ends (the higher particle numbers) take their shares, then its lower
+//      ends: f += f1 on the i side, f -= f1 on the j side, as in add_forces.
+//
+// Bit for bit the same sums: a particle collects its springs in the order add_forces adds them.
+// Across runs that is run order. Within a run from particles L0 + t to U0 + t (L0 < U0), a
+// particle p is the upper end of spring p - U0 and the lower end of spring p - L0, which comes
+// later: in a later chunk, or in the same chunk, where upper ends go first.
+//
+// With several threads, each owns a contiguous range of particles and adds only to those: it
+// takes every spring with an end in its range. A spring between two ranges is computed by both
+// threads (the same bits twice); nothing is shared, so there are no locks and no atomics.
+
+namespace {
+
+constexpr Index kChunk = 256;  // springs per chunk: f1 of a chunk takes 6 KiB
+
+// The forces f1 of springs t = 0 .. count - 1 of a run: spring t joins the particles whose
+// components sit at x1[t], x1[t + n], x1[t + 2n] and x2[t], ... (n: particles in all), and its f1
+// goes to f1x[t], f1y[t], f1z[t]. A function of its own, not inlined, so that every pointer can
+// be declared not to overlap the others: then the compiler vectorises the loop, kernel inlined.
+[[gnu::noinline]] void run_kernel(Index count, Index n, const double* __restrict x1,
+                                  const double* __restrict x2, const double* __restrict v1,
+                                  const double* __restrict v2, const double* __restrict ks,
+                                  const double* __restrict kd, const double* __restrict l0,
+                                  double* __restrict f1x, double* __restrict f1y,
+                                  double* __restrict f1z) {
+  for (Index t = 0; t < count; ++t) {
+    const Vec3 f1 = spring_damper_force(Vec3(x1[t], x1[n + t], x1[2 * n + t]),
+                                        Vec3(x2[t], x2[n + t], x2[2 * n + t]),
+                                        Vec3(v1[t], v1[n + t], v1[2 * n + t]),
+                                        Vec3(v2[t], v2[n + t], v2[2 * n + t]), ks[t], kd[t], l0[t]);
+    f1x[t] = f1.x();
+    f1y[t] = f1.y();
+    f1z[t] = f1.z();
+  }
+}
+
+// f[c][t] += f1[c][t] (add) or -= (subtract), for t = 0 .. count - 1 and each component c;
+// f's components are n apart, f1's kChunk apart.
+void add_shares(Index count, Index n, const double* __restrict f1, double* __restrict f, bool add) {
+  for (int c = 0; c < 3; ++c) {
+    double* __restrict fc = f + c * n;
+    const double* __restrict f1c = f1 + c * kChunk;
+    if (add) {
+      for (Index t = 0; t < count; ++t)
+        fc[t] += f1c[t];
+    } else {
+      for (Index t = 0; t < count; ++t)
+        fc[t] -= f1c[t];
+    }
+  }
+}
+
+}  // namespace
+
+bool SpringDampers::adds_soa(const Particles& /*p*/) const {
+  RunLayout& lay = layout_;
+  const SpringSet& s = springs_;
+  if (lay.generation != s.generation || lay.springs != s.size()) {
+    lay.generation = s.generation;
+    lay.springs = s.size();
+    lay.runs = spring_runs(s);
+  }
+  assert(lay.runs == spring_runs(s) && "i or j changed in place without SpringSet::changed()");
+  // Runs of a few springs cost more in bookkeeping than they save: such a set (springs given
+  // one by one, or shuffled) is evaluated by add_forces.
+  constexpr size_t kMinMeanRun = 8;
+  return s.size() >= kMinMeanRun * lay.runs.size();
+}
+
+void SpringDampers::add_run(const SpringRun& run, Index p_begin, Index p_end, const SoA3& x,
+                            const SoA3& v, SoA3& f) const {
+  const Index n = x.cols();
+  const Index lower = std::min(run.i0, run.j0), upper = std::max(run.i0, run.j0);
+  const auto in_run = [&](Index t) { return std::clamp<Index>(t, 0, run.length); };
+  // The springs with an upper end in [p_begin, p_end), and those with a lower end there.
+  const Index up_begin = in_run(p_begin - upper), up_end = in_run(p_end - upper);
+  const Index lo_begin = in_run(p_begin - lower), lo_end = in_run(p_end - lower);
+  if (up_begin == up_end && lo_begin == lo_end) return;
+  const Index first = up_begin < up_end ? up_begin : lo_begin;
+  const Index last = lo_begin < lo_end ? lo_end : up_end;
+  const bool upper_is_j = run.j0 > run.i0;
+  double f1[3 * kChunk];
+  for (Index c0 = first; c0 < last; c0 += kChunk) {
+    const Index c1 = std::min(c0 + kChunk, last);
+    const Index k = static_cast<Index>(run.k0) + c0;
+    run_kernel(c1 - c0, n, x.data() + run.i0 + c0, x.data() + run.j0 + c0, v.data() + run.i0 + c0,
+               v.data() + run.j0 + c0, springs_.ks.data() + k, springs_.kd.data() + k,
+               springs_.l0.data() + k, f1, f1 + kChunk, f1 + 2 * kChunk);
+    // The upper ends' shares, then the lower ends'.
+    const Index u0 = std::max(c0, up_begin), u1 = std::min(c1, up_end);
+    if (u0 < u1) add_shares(u1 - u0, n, f1 + (u0 - c0), f.data() + upper + u0, !upper_is_j);
+    const Index l0 = std::max(c0, lo_begin), l1 = std::min(c1, lo_end);
+    if (l0 < l1) add_shares(l1 - l0, n, f1 + (l0 - c0), f.data() + lower + l0, upper_is_j);
+  }
+}
+
+void SpringDampers::add_forces_soa(const Particles& /*p*/, const SoA3& x, const SoA3& v, SoA3& f,
+                                   ThreadTeam* team) const {
+  for_ranges(team, f.cols(), [&](Index p_begin, Index p_end) {
+    for (const SpringRun& run : layout_.runs)
+      add_run(run, p_begin, p_end, x, v, f);
+  });
 }
 
 double SpringDampers::potential_energy(const Particles& /*p*/, const Matrix3X& x) const {

@@ -49,25 +49,51 @@ Vec3 spring_damper_force(const Vec3& r1, const Vec3& r2, const Vec3& v1, const V
 double spring_energy(const Vec3& r1, const Vec3& r2, double ks, double l0);
 
 // A family of springs as parallel arrays: spring k joins particles i[k] and j[k].
+//
+// The fast path (fast_forces.hpp) keeps a description of i and j as runs (see SpringRun), built
+// again whenever `generation` changes. add() and erase() set it to a number no other change, of
+// any set, has had; code that edits i or j in place, or builds a set by push_back, calls
+// changed() afterwards. ks, kd and l0 may change freely (plasticity changes l0 every step): the
+// runs hold indices only.
 struct SpringSet {
   std::vector<Index> i, j;
-  std::vector<double> ks;       // spring constants [N/m]
-  std::vector<double> kd;       // damping factors [N s/m]
-  std::vector<double> l0;       // rest lengths [m]; plasticity (lesson 06) may change them
-  std::vector<double> l_built;  // rest lengths as built [m], for plastic strain limits
+  std::vector<double> ks;        // spring constants [N/m]
+  std::vector<double> kd;        // damping factors [N s/m]
+  std::vector<double> l0;        // rest lengths [m]; plasticity (lesson 06) may change them
+  std::vector<double> l_built;   // rest lengths as built [m], for plastic strain limits
+  unsigned long generation = 0;  // which change to i and j this set is at (see above)
 
   size_t size() const { return i.size(); }
   // Adds a spring from a to b; l0 < 0 means "the distance between them in x".
   void add(Index a, Index b, double ks_ab, double kd_ab, double l0_ab, const Matrix3X& x);
   // Removes the springs at the given positions (ascending), keeping the others in order.
   void erase(const std::vector<size_t>& positions);
+  // Says that i or j were changed in place: layouts built from them are out of date.
+  void changed();
 };
+
+// A stretch of springs that join consecutive particles: springs k0, k0 + 1, ..., k0 + length - 1
+// of a set join particles i0 + t and j0 + t, t = 0, 1, ..., length - 1. A grid's families come in
+// such runs (the row springs of row r are one, with j0 = i0 + 1), so a loop over a run reads
+// positions and writes forces in memory order, with no index arrays to chase.
+struct SpringRun {
+  size_t k0;     // first spring of the run in the set
+  Index i0, j0;  // particles of its first spring
+  Index length;  // springs in the run
+  bool operator==(const SpringRun&) const = default;
+};
+
+// The springs of `s`, in their order, cut into the longest runs they form. A set without such
+// structure comes out as runs of length 1; the runs always cover every spring exactly once.
+std::vector<SpringRun> spring_runs(const SpringSet& s);
 
 // The spring effect of `world` called `name` ("springs" or "bending"), or nullptr.
 SpringDampers* find_spring_effect(World& world, std::string_view name);
 
 // Appends one spring per pair (a, b), joining particles first + a and first + b, with rest
-// lengths measured in x (the distance at build time).
+// lengths measured in x (the distance at build time). The pairs are added sorted by (b - a, a),
+// so that a grid's springs form long runs (see SpringRun): the row springs of a cloth, then its
+// column springs, and so on, whatever order the builder listed them in.
 void add_spring_family(SpringSet& springs, const std::vector<std::pair<Index, Index>>& pairs,
                        Index first, double ks, double kd, const Matrix3X& x);
 
@@ -86,9 +112,27 @@ class SpringDampers final : public ForceEffect {
   const SpringSet& springs() const { return springs_; }
   SpringSet& springs() { return springs_; }
 
+  // The fast path (fast_forces.hpp): the same forces, run by run (see SpringRun). A set that
+  // forms few runs (springs listed in no particular order) is left to add_forces.
+  bool adds_soa(const Particles& p) const override;
+  void add_forces_soa(const Particles& p, const SoA3& x, const SoA3& v, SoA3& f,
+                      ThreadTeam* team) const override;
+
  private:
+  // Adds the forces of the springs of `run` on the particles [p_begin, p_end) to f.
+  void add_run(const SpringRun& run, Index p_begin, Index p_end, const SoA3& x, const SoA3& v,
+               SoA3& f) const;
+
   std::string name_;
   SpringSet springs_;
+
+  // The fast path's view of springs_, built again when springs_.generation changes.
+  struct RunLayout {
+    unsigned long generation = 0;
+    size_t springs = 0;
+    std::vector<SpringRun> runs;
+  };
+  mutable RunLayout layout_;
 };
 
 }  // namespace clothlab

@@ -3,6 +3,8 @@
 #include <cassert>
 #include <chrono>
 
+#include "clothlab/fast_forces.hpp"
+
 namespace clothlab {
 
 namespace {
@@ -53,7 +55,23 @@ void World::step(double dt) {
   timing->guard += seconds_since(start);
 }
 
+ThreadTeam* World::team() const {
+  if (threads <= 1) return nullptr;
+  if (!team_ || team_->size() != threads) team_ = std::make_unique<ThreadTeam>(threads);
+  return team_.get();
+}
+
 void World::compute_forces(const Matrix3X& x, const Matrix3X& v, Matrix3X& f) const {
+  if (!takes_fast_path() || !prepare_fast_forces(*this, fast_)) {
+    compute_forces_readable(x, v, f);
+    return;
+  }
+  ++force_evaluations;
+  ++fast_evaluations;
+  fast_forces(*this, x, v, f, fast_, team());
+}
+
+void World::compute_forces_readable(const Matrix3X& x, const Matrix3X& v, Matrix3X& f) const {
   f.setZero();
   ++force_evaluations;
   if (!timing) {

@@ -13,9 +13,11 @@
 #include <vector>
 
 #include "clothlab/effect.hpp"
+#include "clothlab/fast_forces.hpp"
 #include "clothlab/guard.hpp"
 #include "clothlab/integrator.hpp"
 #include "clothlab/particles.hpp"
+#include "clothlab/threads.hpp"
 #include "clothlab/triangles.hpp"
 
 namespace clothlab {
@@ -43,16 +45,26 @@ class World {
 
   // How often compute_forces has run: what a multi-stage integrator pays per step.
   mutable long force_evaluations = 0;
+  mutable long fast_evaluations = 0;  // how many of them took the fast path (fast_forces.hpp)
 
   // When set (by `clothlab run --stats`), each step adds the time of each of its parts here.
   // The check costs one branch per effect per evaluation, never one per particle.
   StepTimes* timing = nullptr;
 
+  // How the engine runs ([engine] in a scene, `clothlab run --threads N`).
+  int threads = 1;        // threads a force evaluation may use; 1: the calling thread only
+  bool fast_path = true;  // false: every force evaluation takes the readable path
+
   // Takes one step of dt [s] (steps 1-5 above).
   void step(double dt);
 
-  // Steps 1-2 at an arbitrary state: f = sum of every force effect at (x, v) [N].
+  // Steps 1-2 at an arbitrary state: f = sum of every force effect at (x, v) [N]. On the fast
+  // path (fast_forces.hpp) when an effect has one, unless fast_path is off or --stats is timing
+  // the effects; the two paths give the same f, bit for bit.
   void compute_forces(const Matrix3X& x, const Matrix3X& v, Matrix3X& f) const;
+
+  // The lecture's loop, the one the lessons show: clear f, then each effect adds its forces.
+  void compute_forces_readable(const Matrix3X& x, const Matrix3X& v, Matrix3X& f) const;
 
   // Diagnostics of the current state.
   double kinetic_energy() const;    // sum of 1/2 m |v|^2 [J] (pinned particles do not move)
@@ -61,6 +73,13 @@ class World {
 
   // "gravity, gravitation; symplectic-euler": what a report or an error names as in play.
   std::string effects_in_play() const;
+
+ private:
+  bool takes_fast_path() const { return fast_path && !timing; }
+  ThreadTeam* team() const;  // the threads of the fast path, or null for one thread
+
+  mutable std::unique_ptr<ThreadTeam> team_;
+  mutable FastScratch fast_;
 };
 
 }  // namespace clothlab

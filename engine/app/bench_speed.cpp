@@ -1,0 +1,525 @@
+// bench_speed.cpp: `clothlab bench speed`, what a step of cloth costs and where the time goes.
+//
+// The scene: an N x N cloth, 1 cm apart, hanging from its two top corners, with structural,
+// shear and bending springs, gravity and symplectic Euler, for N in {32, 64, 128, 256}. Every
+// figure is the median over repeats of the wall time of many steps, per spring and step, and
+// every variant runs in the same process, one after the other, so that ratios compare like
+// with like:
+//
+//   reference       the engine's own step (the fast path), on 1 thread and on every core
+//   readable        the same step on the readable path ([engine] fast_path = false)
+//   naive           a lecture-style engine kept here: an array of particle objects, spring
+//                   objects holding pointers to their two particles, ComputeForce() per spring
+//   +aerodynamics   the reference with [aerodynamics] added, then [ground] as well
+//   student         the same scene in clothlab-student (your exercises), run as a subprocess;
+//                   skipped, saying which, while an exercise it needs is still a stub
+//   implicit        implicit Euler on a stiff cloth: the whole step, then its assembly (forces,
+//                   Jacobians, the matrix) and its linear solve
+//
+// All variants but `implicit` compute the same physics; the naive one is checked against the
+// engine after a few steps, and the readable and fast paths agree bit for bit (a test checks it).
+#include <fcntl.h>
+#include <spawn.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <functional>
+#include <memory>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include <fmt/format.h>
+#include <CLI/CLI.hpp>
+
+#include "app/bench.hpp"
+#include "app/build_info.hpp"
+#include "clothlab/cloth.hpp"
+#include "clothlab/euler.hpp"
+#include "clothlab/gravity.hpp"
+#include "clothlab/implicit_euler.hpp"
+#include "clothlab/not_implemented.hpp"
+#include "clothlab/output.hpp"
+#include "clothlab/scene.hpp"
+#include "clothlab/spring_damper.hpp"
+#include "clothlab/threads.hpp"
+
+extern char** environ;
+
+namespace clothlab::app {
+
+namespace {
+
+namespace fs = std::filesystem;
+
+struct SpeedOptions {
+  std::vector<int> sizes{32, 64, 128, 256};
+  int repeats = 5;
+  double min_seconds = 0.25;  // [s] wall time of one repeat
+  int threads = 0;            // "all cores": 0 asks the machine
+  std::string csv;
+  std::vector<std::string> variants;  // empty: every variant
+  bool quick = false;
+  bool no_student = false;
+};
+
+struct Measurement {
+  std::string variant;
+  int n = 0;
+  int threads = 1;
+  long springs = 0;
+  double ns_per_spring_step = 0.0;  // [ns]
+  double steps_per_s = 0.0;         // [1/s]
+  std::string note;
+};
+
+// The scene's constants. Per particle 1 g, springs of 50 N/m: the stiffest mode has
+// w <= sqrt(4 * 2 * (2 * 50 + 10) / 0.001) ~ 940 rad/s, so dt = 0.5 ms (w dt < 0.5) is well
+// inside symplectic Euler's limit of w dt < 2 at every size.
+constexpr double kSpacing = 0.01;       // [m]
+constexpr double kParticleMass = 1e-3;  // [kg]
+constexpr double kKs = 50.0, kKd = 0.01;
+constexpr double kBendKs = 10.0, kBendKd = 0.005;
+constexpr double kDt = 5e-4;  // [s]
+
+std::string cloth_scene(int n, int threads, bool fast, const std::string& extra,
+                        const std::string& method = "symplectic-euler", double ks = kKs,
+                        double dt = kDt) {
+  return fmt::format(
+      "title = \"bench speed\"\n"
+      "[cloth]\nrows = {0}\ncols = {0}\nspacing = {1}\norigin = [0.0, 1.0, 0.0]\nmass = {2}\n"
+      "pins = \"top-corners\"\n"
+      "[springs]\nks = {3}\nkd = {4}\n"
+      "[bending]\nks = {5}\nkd = {6}\n"
+      "[gravity]\n{7}\n"
+      "[integrator]\nmethod = \"{8}\"\ndt = {9}\nduration = 1000.0\n"
+      "[engine]\nthreads = {10}\nfast_path = {11}\n",
+      n, kSpacing, kParticleMass * n * n, ks, kKd, kBendKs, kBendKd, extra, method, dt, threads,
+      fast ? "true" : "false");
+}
+
+long spring_count(const World& world) {
+  long count = 0;
+  for (const auto& effect : world.force_effects) {
+    if (const auto* s = dynamic_cast<const SpringDampers*>(effect.get())) {
+      count += static_cast<long>(s->springs().size());
+    }
+  }
+  return count;
+}
+
+// One thing to measure: a step function and what its row says.
+struct Contender {
+  std::string variant;
+  int threads = 1;
+  long springs = 0;
+  std::function<void()> step;
+  std::vector<double> samples;  // [s] per step, one per repeat
+};
+
+// Median wall time [s] of one step of each contender, over `repeats` repeats of enough steps to
+// last `min_seconds` each (at least 2). The contenders take turns, repeat by repeat, so that a
+// machine busy with something else slows them all alike and the ratios stay fair.
+void time_steps(std::vector<Contender>& contenders, const SpeedOptions& opt) {
+  using Clock = std::chrono::steady_clock;
+  std::vector<long> steps;
+  for (Contender& c : contenders) {
+    const Clock::time_point start = Clock::now();
+    c.step();  // warm up: caches, the first step's guard setup, the threads
+    c.step();
+    const double first = std::chrono::duration<double>(Clock::now() - start).count() / 2.0;
+    steps.push_back(
+        std::clamp<long>(std::lround(opt.min_seconds / std::max(first, 1e-9)), 2, 10'000'000));
+  }
+  for (int r = 0; r < opt.repeats; ++r) {
+    for (size_t k = 0; k < contenders.size(); ++k) {
+      const Clock::time_point start = Clock::now();
+      for (long s = 0; s < steps[k]; ++s)
+        contenders[k].step();
+      contenders[k].samples.push_back(std::chrono::duration<double>(Clock::now() - start).count() /
+                                      static_cast<double>(steps[k]));
+    }
+  }
+}
+
+double median(std::vector<double> samples) {
+  std::sort(samples.begin(), samples.end());
+  const size_t mid = samples.size() / 2;
+  return samples.size() % 2 == 1 ? samples[mid] : 0.5 * (samples[mid - 1] + samples[mid]);
+}
+
+Measurement make_row(const std::string& variant, int n, int threads, long springs, double seconds,
+                     std::string note = "") {
+  return {variant,
+          n,
+          threads,
+          springs,
+          1e9 * seconds / static_cast<double>(springs),
+          1.0 / seconds,
+          std::move(note)};
+}
+
+// --- The naive baseline --------------------------------------------------------------------
+//
+// The lecture's first engine, as a student would write it: one object per particle, one per
+// spring with pointers to its particles, and three loops a step (gravity, springs, Euler). It
+// calls the same exercise kernels as the engine: the difference measured is the layout.
+
+struct NaiveParticle {
+  Vec3 x, v, f;  // position [m], velocity [m/s], force [N]
+  double m;      // mass [kg]
+  double inv_m;  // 1/m [1/kg], 0 when pinned
+};
+
+struct NaiveSpring {
+  NaiveParticle* p1;
+  NaiveParticle* p2;
+  double ks, kd, l0;  // [N/m], [N s/m], [m]
+
+  void ComputeForce() {
+    const Vec3 f1 = spring_damper_force(p1->x, p2->x, p1->v, p2->v, ks, kd, l0);
+    p1->f += f1;
+    p2->f -= f1;
+  }
+};
+
+struct NaiveCloth {
+  std::vector<NaiveParticle> particles;
+  std::vector<NaiveSpring> springs;
+  Vec3 g{0.0, -9.8, 0.0};  // [m/s^2]
+
+  void Step(double dt) {
+    for (NaiveParticle& p : particles)
+      p.f = gravity_force(p.m, g);
+    for (NaiveSpring& s : springs)
+      s.ComputeForce();
+    for (NaiveParticle& p : particles) {
+      const PointState next = symplectic_euler_step(p.x, p.v, p.f, p.inv_m, dt);
+      p.x = next.r;
+      p.v = next.v;
+    }
+  }
+};
+
+// The naive cloth of the same particles, springs in the order the builders list them.
+NaiveCloth naive_cloth(const World& world, int n) {
+  NaiveCloth cloth;
+  const Particles& p = world.particles;
+  for (Index i = 0; i < p.size(); ++i)
+    cloth.particles.push_back({p.x.col(i), p.v.col(i), Vec3::Zero(), p.m[i], p.inv_m[i]});
+  const auto add = [&](const std::vector<IndexPair>& pairs, double ks, double kd) {
+    for (const auto& [a, b] : pairs) {
+      NaiveParticle* p1 = &cloth.particles[static_cast<size_t>(a)];
+      NaiveParticle* p2 = &cloth.particles[static_cast<size_t>(b)];
+      cloth.springs.push_back({p1, p2, ks, kd, (p2->x - p1->x).norm()});
+    }
+  };
+  add(structural_pairs(n, n), kKs, kKd);
+  add(shear_pairs(n, n), kKs, kKd);
+  add(bending_pairs(n, n), kBendKs, kBendKd);
+  return cloth;
+}
+
+// --- The variants --------------------------------------------------------------------------
+
+bool wanted(const SpeedOptions& opt, const std::string& variant) {
+  return opt.variants.empty() ||
+         std::find(opt.variants.begin(), opt.variants.end(), variant) != opt.variants.end();
+}
+
+void measure_size(int n, int all_cores, const SpeedOptions& opt, std::vector<Measurement>& rows) {
+  // Every contender's state lives here until all are measured.
+  std::vector<std::unique_ptr<Scene>> scenes;
+  std::vector<Contender> contenders;
+  std::vector<std::string> notes;
+  const auto engine = [&](const std::string& variant, int threads, bool fast,
+                          const std::string& extra) {
+    scenes.push_back(
+        std::make_unique<Scene>(parse_scene(cloth_scene(n, threads, fast, extra), "<bench>")));
+    Scene& scene = *scenes.back();
+    contenders.push_back({variant,
+                          threads,
+                          spring_count(scene.world),
+                          [&scene] { scene.world.step(scene.dt); },
+                          {}});
+    notes.emplace_back();
+  };
+  std::vector<int> thread_counts{1};
+  if (all_cores > 1) thread_counts.push_back(all_cores);
+
+  if (wanted(opt, "reference")) {
+    for (int threads : thread_counts)
+      engine("reference", threads, true, "");
+  }
+  if (wanted(opt, "readable")) engine("readable", 1, false, "");
+  NaiveCloth naive;
+  if (wanted(opt, "naive")) {
+    Scene scene = parse_scene(cloth_scene(n, 1, true, ""), "<bench>");
+    naive = naive_cloth(scene.world, n);
+    // The same physics: after a few steps the two agree to rounding (the sums run in another
+    // order), which the note shows.
+    NaiveCloth check = naive;
+    for (NaiveSpring& s : check.springs) {
+      s.p1 = &check.particles[static_cast<size_t>(s.p1 - naive.particles.data())];
+      s.p2 = &check.particles[static_cast<size_t>(s.p2 - naive.particles.data())];
+    }
+    for (int k = 0; k < 20; ++k) {
+      check.Step(scene.dt);
+      scene.world.step(scene.dt);
+    }
+    double gap = 0.0;
+    for (size_t i = 0; i < check.particles.size(); ++i) {
+      const Vec3 x = scene.world.particles.x.col(static_cast<Index>(i));
+      gap = std::max(gap, (check.particles[i].x - x).cwiseAbs().maxCoeff());
+    }
+    const double dt = scene.dt;
+    contenders.push_back({"naive",
+                          1,
+                          static_cast<long>(naive.springs.size()),
+                          [&naive, dt] { naive.Step(dt); },
+                          {}});
+    notes.push_back(fmt::format("agrees with reference to {:.1e} m after 20 steps", gap));
+  }
+  const std::string aero = "[aerodynamics]\nwind = [2.0, 0.0, 1.0]\n";
+  const std::string ground = "[ground]\ny = 0.5\ne = 0.2\nmu_s = 0.5\nmu_d = 0.3\n";
+  if (wanted(opt, "+aerodynamics")) {
+    for (int threads : thread_counts)
+      engine("+aerodynamics", threads, true, aero);
+  }
+  if (wanted(opt, "+aerodynamics+ground")) {
+    for (int threads : thread_counts)
+      engine("+aerodynamics+ground", threads, true, aero + ground);
+  }
+  const ImplicitEuler* implicit = nullptr;
+  if (wanted(opt, "implicit")) {
+    // Stiff: 100 times the springs' ks, dt 4 times the scene's; explicit methods would need
+    // dt < 2 / w ~ 0.2 ms here, implicit Euler takes 2 ms.
+    scenes.push_back(std::make_unique<Scene>(parse_scene(
+        cloth_scene(n, 1, true, "", "implicit-euler", 100.0 * kKs, 4 * kDt), "<bench>")));
+    Scene& scene = *scenes.back();
+    implicit = dynamic_cast<const ImplicitEuler*>(scene.world.integrator.get());
+    contenders.push_back(
+        {"implicit", 1, spring_count(scene.world), [&scene] { scene.world.step(scene.dt); }, {}});
+    notes.emplace_back();
+  }
+
+  time_steps(contenders, opt);
+  for (size_t k = 0; k < contenders.size(); ++k) {
+    const Contender& c = contenders[k];
+    rows.push_back(make_row(c.variant, n, c.threads, c.springs, median(c.samples), notes[k]));
+  }
+  if (implicit) {
+    // Its assembly and its solve, as averages over every step it took (the figure above is
+    // the median of the repeats).
+    const LinearSolveStats& st = implicit->stats();
+    const double per_solve = 1.0 / static_cast<double>(std::max(st.solves, 1L));
+    const long springs = contenders.back().springs;
+    rows.back().note =
+        fmt::format("ks = {} N/m, dt = {} s, {:.1f} CG iterations per solve", 100.0 * kKs, 4 * kDt,
+                    static_cast<double>(st.iterations) * per_solve);
+    rows.push_back(make_row("implicit-assembly", n, 1, springs, st.assembly_seconds * per_solve,
+                            "f0, Jacobians, A and b (mean)"));
+    rows.push_back(make_row("implicit-solve", n, 1, springs, st.solve_seconds * per_solve,
+                            "conjugate gradients (mean)"));
+  }
+}
+
+// --- The student build, as a subprocess -----------------------------------------------------
+
+// Runs clothlab-student (found beside this program) on the reference variant and adds its rows
+// as "student"; returns why not, when it could not.
+std::string measure_student(const SpeedOptions& opt, std::vector<Measurement>& rows) {
+  std::error_code error;
+  const fs::path self = fs::read_symlink("/proc/self/exe", error);
+  const fs::path student = self.parent_path() / "clothlab-student";
+  if (error || !fs::exists(student)) return "clothlab-student was not found beside clothlab";
+  const fs::path dir = fs::temp_directory_path() / fmt::format("clothlab-bench-{}", getpid());
+  fs::create_directories(dir);
+  const fs::path csv = dir / "student.csv", log = dir / "student.log";
+  std::vector<std::string> args{student.string(), "bench",
+                                "speed",          "--no-student",
+                                "--variants",     "reference",
+                                "--threads",      "1",
+                                "--repeats",      std::to_string(opt.repeats),
+                                "--min-seconds",  fmt::format("{}", opt.min_seconds),
+                                "--csv",          csv.string(),
+                                "--sizes"};
+  for (int n : opt.sizes)
+    args.push_back(std::to_string(n));
+  std::vector<char*> argv;
+  for (std::string& a : args)
+    argv.push_back(a.data());
+  argv.push_back(nullptr);
+  posix_spawn_file_actions_t actions;
+  posix_spawn_file_actions_init(&actions);
+  posix_spawn_file_actions_addopen(&actions, STDOUT_FILENO, log.c_str(),
+                                   O_WRONLY | O_CREAT | O_TRUNC, 0644);
+  posix_spawn_file_actions_adddup2(&actions, STDOUT_FILENO, STDERR_FILENO);
+  std::fflush(stdout);
+  pid_t pid = 0;
+  const int spawned = posix_spawn(&pid, argv[0], &actions, nullptr, argv.data(), environ);
+  posix_spawn_file_actions_destroy(&actions);
+  if (spawned != 0) return "clothlab-student could not be started";
+  int status = 0;
+  waitpid(pid, &status, 0);
+  std::ifstream log_file(log);
+  const std::string output((std::istreambuf_iterator<char>(log_file)),
+                           std::istreambuf_iterator<char>());
+  std::string why;
+  if (!WIFEXITED(status) || WEXITSTATUS(status) != 0) {
+    // A stub names its exercise: "exercise ex02.1 is not implemented yet: see ...".
+    const size_t at = output.find("exercise ex");
+    if (at != std::string::npos) {
+      const std::string exercise = output.substr(at + 9, output.find(' ', at + 9) - (at + 9));
+      why = fmt::format("{} is not done yet in exercises/", exercise);
+    } else {
+      why = fmt::format("clothlab-student failed:\n{}", output);
+    }
+  } else {
+    std::ifstream file(csv);
+    std::string line;
+    std::getline(file, line);  // the header
+    while (std::getline(file, line)) {
+      std::stringstream in(line);
+      Measurement m;
+      std::string field;
+      std::getline(in, m.variant, ',');
+      std::getline(in, field, ',');
+      m.n = std::stoi(field);
+      std::getline(in, field, ',');
+      m.threads = std::stoi(field);
+      std::getline(in, field, ',');
+      m.springs = std::stol(field);
+      std::getline(in, field, ',');
+      m.ns_per_spring_step = std::stod(field);
+      std::getline(in, field, ',');
+      m.steps_per_s = std::stod(field);
+      m.variant = "student";
+      m.note = "clothlab-student, your kernels";
+      rows.push_back(m);
+    }
+  }
+  fs::remove_all(dir, error);
+  return why;
+}
+
+void print_table(const std::vector<Measurement>& rows) {
+  fmt::print("  {:>4} {:>7}  {:<21} {:>7} {:>13} {:>11} {:>9}  {}\n", "N", "springs", "variant",
+             "threads", "ns/spring-step", "steps/s", "vs naive", "");
+  int n = -1;
+  for (const Measurement& m : rows) {
+    if (m.n != n && n != -1) fmt::print("\n");
+    n = m.n;
+    // The ratio to the naive baseline of the same size, measured in this run.
+    std::string ratio;
+    for (const Measurement& naive : rows) {
+      if (naive.variant == "naive" && naive.n == m.n && m.variant != "naive" &&
+          m.variant.rfind("implicit", 0) != 0) {
+        ratio = fmt::format("{:.2f}x", naive.ns_per_spring_step / m.ns_per_spring_step);
+      }
+    }
+    fmt::print("  {:>4} {:>7}  {:<21} {:>7} {:>13.3f} {:>11.1f} {:>9}  {}\n", m.n, m.springs,
+               m.variant, m.threads, m.ns_per_spring_step, m.steps_per_s, ratio, m.note);
+  }
+}
+
+int bench_speed(SpeedOptions opt) {
+  if (opt.quick) {
+    opt.sizes = {16, 32};
+    opt.repeats = 1;
+    opt.min_seconds = 0.01;
+  }
+  const int all_cores = opt.threads > 0 ? opt.threads : ThreadTeam::hardware_threads();
+  fmt::print(
+      "bench speed: N x N cloth, structural + shear + bending springs, gravity, symplectic Euler, "
+      "two pinned corners\n  {} build, {}; median of {} repeats of at least {} s; 1 thread and "
+      "{} (all cores)\n\n",
+      kKernels,
+      kLinkTimeOptimised ? "kernels inlined by link-time optimisation"
+                         : "link-time optimisation off",
+      opt.repeats, opt.min_seconds, all_cores);
+  std::vector<Measurement> rows;
+  for (int n : opt.sizes)
+    measure_size(n, all_cores, opt, rows);
+
+  std::string student_skipped;
+  if (!opt.no_student && wanted(opt, "student")) {
+    if (std::string(kKernels) == "student") {
+      student_skipped = "this is the student build already";
+    } else {
+      student_skipped = measure_student(opt, rows);
+      // Keep each size's rows together.
+      std::stable_sort(rows.begin(), rows.end(),
+                       [](const Measurement& a, const Measurement& b) { return a.n < b.n; });
+    }
+  }
+  print_table(rows);
+  if (!student_skipped.empty()) fmt::print("\n  student: skipped: {}\n", student_skipped);
+
+  if (!opt.csv.empty()) {
+    const fs::path csv = opt.csv;
+    if (csv.has_parent_path()) fs::create_directories(csv.parent_path());
+    std::ofstream file = open_for_writing(csv);
+    file << "variant,n,threads,springs,ns_per_spring_step,steps_per_s,particles\n";
+    for (const Measurement& m : rows) {
+      file << fmt::format("{},{},{},{},{:.6g},{:.6g},{}\n", m.variant, m.n, m.threads, m.springs,
+                          m.ns_per_spring_step, m.steps_per_s, m.n * m.n);
+    }
+    fmt::print("\n  wrote {}\n", csv.string());
+  }
+  return 0;
+}
+
+}  // namespace
+
+void add_bench_speed_command(CLI::App& bench) {
+  static SpeedOptions options;
+  SpeedOptions& o = options;
+  CLI::App* speed = bench.add_subcommand(
+      "speed",
+      "The engine's speed on N x N cloths: ns per spring and step, steps per second, against a "
+      "naive baseline, with effects added, on 1 thread and all cores (table and CSV)");
+  speed->add_option("--sizes", o.sizes, "Cloth sizes N (N x N particles)")
+      ->delimiter(',')
+      ->check(CLI::Range(3, 2048))
+      ->capture_default_str();
+  speed->add_option("--repeats", o.repeats, "Repeats of each measurement (the median is shown)")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
+  speed->add_option("--min-seconds", o.min_seconds, "Wall time [s] of each repeat")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
+  speed->add_option("--threads", o.threads, "Threads of the all-cores rows (default: every core)")
+      ->check(CLI::Range(1, 1024));
+  speed->add_option("--csv", o.csv, "Write one row per measurement to this CSV file");
+  speed
+      ->add_option("--variants", o.variants,
+                   "Variants to measure (default: all): reference, readable, naive, "
+                   "+aerodynamics, +aerodynamics+ground, implicit, student")
+      ->delimiter(',');
+  speed->add_flag("--quick", o.quick, "Sizes 16 and 32, one short repeat (for tests)");
+  speed->add_flag("--no-student", o.no_student, "Do not run clothlab-student");
+  speed->callback([] {
+    int status = 0;
+    try {
+      status = bench_speed(options);
+    } catch (const NotImplemented& e) {
+      std::fflush(stdout);
+      fmt::print(stderr, "error: {}\n", e.what());
+      status = 4;  // as `clothlab run`: an exercise kernel is still a stub
+    } catch (const std::exception& e) {
+      std::fflush(stdout);
+      fmt::print(stderr, "error: bench speed: {}\n", e.what());
+      status = 1;
+    }
+    if (status != 0) throw CLI::RuntimeError(status);
+  });
+}
+
+}  // namespace clothlab::app

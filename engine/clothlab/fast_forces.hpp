@@ -1,0 +1,44 @@
+// fast_forces.hpp: the fast path of a force evaluation, on a structure-of-arrays copy of the state.
+//
+// World::compute_forces_readable is the lecture's loop: clear every force, then let each effect
+// add its forces, particle by particle or spring by spring, on the engine's own layout (one
+// column x, y, z per particle). It is what the lessons show. The fast path computes the same
+// sums on another layout:
+//
+//   1. copy x and v into SoA3 (all x components, then all y, then all z) and clear f there;
+//   2. every effect adds its forces there (ForceEffect::add_forces_soa): a loop over particles,
+//      or over a run of springs (spring_damper.hpp), reads each component in memory order, so
+//      the compiler computes four springs at once with vector instructions, through the same
+//      exercise kernels;
+//   3. copy f back.
+//
+// Each particle receives the same floating-point operations in the same order as on the readable
+// path, so the two agree bit for bit, with any number of threads (tests/engine/fast_path.cpp).
+// An effect without such a path (aerodynamics on triangles, gravitation) adds its forces with
+// add_forces, on the engine's layout, in its turn: f is copied across when the layout changes.
+#pragma once
+
+#include <vector>
+
+#include "clothlab/effect.hpp"
+
+namespace clothlab {
+
+class World;
+
+// The fast path's copies of the state, kept by the world between evaluations.
+struct FastScratch {
+  SoA3 x, v, f;
+  std::vector<char> soa;  // which force effects take the fast path, by their place in the world
+};
+
+// Asks every force effect whether it has a fast path (once per evaluation, on one thread: an
+// effect may update its caches) and notes the answers in scratch. Whether any has one.
+bool prepare_fast_forces(const World& world, FastScratch& scratch);
+
+// Forces at (x, v) into f, as World::compute_forces_readable computes them, through the fast
+// path, after prepare_fast_forces. `team` may be null (one thread).
+void fast_forces(const World& world, const Matrix3X& x, const Matrix3X& v, Matrix3X& f,
+                 FastScratch& scratch, ThreadTeam* team);
+
+}  // namespace clothlab

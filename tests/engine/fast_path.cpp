@@ -1,0 +1,262 @@
+// The fast path (fast_forces.hpp) against the readable one: the same numbers, bit for bit, on
+// any number of threads; the runs layout describes exactly the springs of a set, and keeps
+// doing so while tearing erases springs and plasticity changes rest lengths.
+#include <doctest/doctest.h>
+
+#include <algorithm>
+#include <atomic>
+#include <numeric>
+#include <random>
+#include <set>
+#include <stdexcept>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "clothlab/bending.hpp"
+#include "clothlab/cloth.hpp"
+#include "clothlab/scene.hpp"
+#include "clothlab/spring_damper.hpp"
+#include "clothlab/threads.hpp"
+
+using clothlab::Index;
+using clothlab::Matrix3X;
+
+namespace {
+
+// A cloth of rows x cols hanging from its top corners, with every effect that has a fast path,
+// aerodynamics (which has none: f goes back and forth between the layouts) between them, and
+// `extra` tables. Its column springs form a run of 44 x 41 = 1804 springs, seven chunks and a
+// short one (spring_damper.cpp).
+std::string cloth(const std::string& extra, const std::string& method = "symplectic-euler",
+                  Index rows = 45, Index cols = 41) {
+  return "[cloth]\nrows = " + std::to_string(rows) + "\ncols = " + std::to_string(cols) +
+         R"(
+spacing = 0.02
+mass = 0.5
+pins = "top-corners"
+[springs]
+ks = 60
+kd = 0.02
+shear_ks = 40
+shear_kd = 0.01
+[bending]
+ks = 5
+kd = 0.002
+[damping]
+rate = 0.05
+[gravity]
+[aerodynamics]
+wind = [3, 0, 2]
+[drag]
+area = 0.0004
+[ground]
+y = -0.6
+[integrator]
+method = ")" +
+         method + R"("
+dt = 0.0005
+duration = 1.0
+)" + extra;
+}
+
+// The scene stepped `steps` times with the given engine settings.
+clothlab::Scene run(const std::string& text, bool fast, int threads, int steps) {
+  clothlab::Scene scene = clothlab::parse_scene(text, "fast-path.toml");
+  scene.world.fast_path = fast;
+  scene.world.threads = threads;
+  for (int s = 0; s < steps; ++s)
+    scene.world.step(scene.dt);
+  return scene;
+}
+
+// Bit for bit: == on doubles (no tolerance).
+bool identical(const Matrix3X& a, const Matrix3X& b) {
+  return a.cols() == b.cols() && (a.array() == b.array()).all();
+}
+
+clothlab::SpringDampers* spring_effect(clothlab::World& world, const char* name) {
+  return clothlab::find_spring_effect(world, name);
+}
+
+std::set<std::pair<Index, Index>> pairs_of(const clothlab::SpringSet& s) {
+  std::set<std::pair<Index, Index>> ends;
+  for (size_t k = 0; k < s.size(); ++k)
+    ends.insert({s.i[k], s.j[k]});
+  return ends;
+}
+
+}  // namespace
+
+TEST_CASE("fast path: runs cover every spring of a set once and in order") {
+  clothlab::Scene scene = clothlab::parse_scene(cloth(""), "runs.toml");
+  for (const char* name : {"springs", "bending"}) {
+    const clothlab::SpringSet& s = spring_effect(scene.world, name)->springs();
+    const std::vector<clothlab::SpringRun> runs = clothlab::spring_runs(s);
+    size_t k = 0;
+    for (const clothlab::SpringRun& run : runs) {
+      REQUIRE(run.k0 == k);
+      for (Index t = 0; t < run.length; ++t, ++k) {
+        CHECK(s.i[k] == run.i0 + t);
+        CHECK(s.j[k] == run.j0 + t);
+      }
+    }
+    CHECK(k == s.size());
+    // A grid's families are long runs: the rows of each family (45 rows) and a few more, not
+    // one run per spring. That is what makes the fast path fast.
+    CHECK(runs.size() < 6 * 45);
+    CHECK(s.size() >= 8 * runs.size());
+  }
+}
+
+TEST_CASE("fast path: the builders' runs order keeps the same springs as the pairs listed") {
+  const Index rows = 7, cols = 5;
+  clothlab::Particles p;
+  const clothlab::ClothGrid grid = clothlab::add_cloth(p, {rows, cols, 0.1, {}, false, 1.0});
+  clothlab::SpringSet s;
+  const std::vector<clothlab::IndexPair> pairs = clothlab::structural_pairs(rows, cols);
+  clothlab::add_spring_family(s, pairs, grid.first, 10.0, 0.1, p.x);
+  const std::set<std::pair<Index, Index>> expected(pairs.begin(), pairs.end());
+  CHECK(pairs_of(s) == expected);
+  CHECK(s.size() == pairs.size());
+  // Every spring's rest length is the distance it was built at, whatever its place.
+  for (size_t k = 0; k < s.size(); ++k)
+    CHECK(s.l0[k] == doctest::Approx((p.x.col(s.j[k]) - p.x.col(s.i[k])).norm()));
+  // Rows first (direction +1), then columns (+cols): one run per row, one for all columns.
+  CHECK(clothlab::spring_runs(s).size() == static_cast<size_t>(rows + 1));
+}
+
+TEST_CASE("fast path: the same state as the readable path, bit for bit, every integrator") {
+  // Explicit Euler gains energy on undamped springs: few enough steps that it has not blown up.
+  const std::vector<std::pair<std::string, int>> methods = {
+      {"symplectic-euler", 150}, {"explicit-euler", 30}, {"rk4", 150}, {"velocity-verlet", 150}};
+  for (const auto& [method, steps] : methods) {
+    CAPTURE(method);
+    const std::string text = cloth("", method);
+    const clothlab::Scene readable = run(text, false, 1, steps);
+    const clothlab::Scene fast = run(text, true, 1, steps);
+    CHECK(identical(fast.world.particles.x, readable.world.particles.x));
+    CHECK(identical(fast.world.particles.v, readable.world.particles.v));
+    // The fast one did take the fast path, every evaluation; the readable one never did.
+    CHECK(fast.world.fast_evaluations == fast.world.force_evaluations);
+    CHECK(fast.world.fast_evaluations >= steps);
+    CHECK(readable.world.fast_evaluations == 0);
+    // The cloth moved: the test compares something.
+    CHECK((fast.world.particles.x - clothlab::parse_scene(text, "t").world.particles.x)
+              .cwiseAbs()
+              .maxCoeff() > 1e-4);
+  }
+}
+
+TEST_CASE("fast path: forces of one evaluation equal the readable path's, bit for bit") {
+  clothlab::Scene scene = run(cloth(""), true, 1, 40);  // a state in motion
+  const clothlab::World& w = scene.world;
+  Matrix3X f_readable(3, w.particles.size()), f_fast(3, w.particles.size());
+  w.compute_forces_readable(w.particles.x, w.particles.v, f_readable);
+  w.compute_forces(w.particles.x, w.particles.v, f_fast);
+  CHECK(identical(f_fast, f_readable));
+}
+
+TEST_CASE("fast path: 2, 3 and 4 threads give the 1-thread state bit for bit") {
+  const std::string text = cloth("");
+  const clothlab::Scene one = run(text, true, 1, 150);
+  for (int threads : {2, 3, 4}) {
+    CAPTURE(threads);
+    const clothlab::Scene many = run(text, true, threads, 150);
+    CHECK(identical(many.world.particles.x, one.world.particles.x));
+    CHECK(identical(many.world.particles.v, one.world.particles.v));
+  }
+  // More threads than some runs have springs.
+  const std::string small = cloth("", "symplectic-euler", 9, 7);
+  CHECK(identical(run(small, true, 4, 50).world.particles.x,
+                  run(small, false, 1, 50).world.particles.x));
+}
+
+TEST_CASE("fast path: tearing and plasticity on the runs layout match the readable path") {
+  // A storm that stretches the sheet past its yield and tearing limits.
+  const std::string text =
+      cloth("[plasticity]\nyield_strain = 0.02\nmax_strain = 0.4\n[tearing]\nstrain = 0.08\n",
+            "symplectic-euler", 24, 24);
+  std::string stormy = text;
+  stormy.replace(stormy.find("wind = [3, 0, 2]"), 16, "wind = [0, 0, 60]");
+  clothlab::Scene readable = run(stormy, false, 1, 1500);
+  clothlab::Scene fast = run(stormy, true, 1, 1500);
+  clothlab::Scene threaded = run(stormy, true, 2, 1500);
+  clothlab::Scene built = clothlab::parse_scene(stormy, "t");
+  const clothlab::SpringSet& s = spring_effect(fast.world, "springs")->springs();
+  const clothlab::SpringSet& r = spring_effect(readable.world, "springs")->springs();
+  REQUIRE(s.size() < spring_effect(built.world, "springs")->springs().size());  // springs tore
+  CHECK(identical(fast.world.particles.x, readable.world.particles.x));
+  CHECK(identical(threaded.world.particles.x, readable.world.particles.x));
+  CHECK(s.l0 == r.l0);  // plastic flow, spring by spring
+  CHECK(pairs_of(s) == pairs_of(r));
+}
+
+TEST_CASE("fast path: a set changed in place, or with no runs, still gives the readable result") {
+  const std::string text = cloth("", "symplectic-euler", 20, 20);
+  clothlab::Scene fast = clothlab::parse_scene(text, "a.toml");
+  clothlab::Scene readable = clothlab::parse_scene(text, "b.toml");
+  readable.world.fast_path = false;
+  fast.world.threads = 2;
+  // Shuffle the springs and flip every other one, in place, then say so. The set forms no runs
+  // any more: the fast path hands it to add_forces, which sums in the new order.
+  for (clothlab::World* w : {&fast.world, &readable.world}) {
+    clothlab::SpringSet& s = spring_effect(*w, "springs")->springs();
+    std::vector<size_t> order(s.size());
+    std::iota(order.begin(), order.end(), size_t{0});
+    std::shuffle(order.begin(), order.end(), std::mt19937(7));
+    clothlab::SpringSet out;
+    for (size_t k : order)
+      out.add(s.i[k], s.j[k], s.ks[k], s.kd[k], s.l0[k], w->particles.x);
+    s = out;
+    for (size_t k = 0; k < s.size(); k += 2)
+      std::swap(s.i[k], s.j[k]);
+    s.changed();
+    CHECK(clothlab::spring_runs(s).size() > s.size() / 2);
+  }
+  for (int step = 0; step < 100; ++step) {
+    fast.world.step(fast.dt);
+    readable.world.step(readable.dt);
+  }
+  CHECK(identical(fast.world.particles.x, readable.world.particles.x));
+}
+
+TEST_CASE("fast path: springs listed from their higher-numbered end match the readable path") {
+  // Every spring flipped: the runs are as long as before, but i0 > j0, so the i ends are the
+  // upper ends and take their shares first.
+  const std::string text = cloth("", "symplectic-euler", 20, 20);
+  clothlab::Scene fast = clothlab::parse_scene(text, "a.toml");
+  clothlab::Scene readable = clothlab::parse_scene(text, "b.toml");
+  readable.world.fast_path = false;
+  for (clothlab::World* w : {&fast.world, &readable.world}) {
+    for (const char* name : {"springs", "bending"}) {
+      clothlab::SpringSet& s = spring_effect(*w, name)->springs();
+      std::swap(s.i, s.j);
+      s.changed();
+      const std::vector<clothlab::SpringRun> runs = clothlab::spring_runs(s);
+      CHECK(s.size() >= 8 * runs.size());
+      CHECK(runs.front().i0 > runs.front().j0);
+    }
+  }
+  for (int step = 0; step < 100; ++step) {
+    fast.world.step(fast.dt);
+    readable.world.step(readable.dt);
+  }
+  CHECK(fast.world.fast_evaluations == 100);
+  CHECK(identical(fast.world.particles.x, readable.world.particles.x));
+  CHECK(identical(fast.world.particles.v, readable.world.particles.v));
+}
+
+TEST_CASE("fast path: a thread team runs every job once and passes on what a job throws") {
+  clothlab::ThreadTeam team(3);
+  std::atomic<int> sum{0};
+  for (int round = 0; round < 100; ++round)
+    team.run([&](int t) { sum += t + 1; });
+  CHECK(sum == 100 * (1 + 2 + 3));
+  CHECK_THROWS_AS(team.run([](int t) {
+    if (t == 2) throw std::runtime_error("a stub");
+  }),
+                  std::runtime_error);
+  team.run([&](int t) { sum += t; });  // still usable
+  CHECK(sum == 100 * 6 + 3);
+}
