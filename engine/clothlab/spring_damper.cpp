@@ -160,6 +160,27 @@ void add_shares(Index count, Index n, const double* __restrict f1, double* __res
   }
 }
 
+// A particle that is the upper end of spring t and the lower end of spring t + gap of the same
+// chunk takes both shares in one visit, upper first: f[c][t] = (f[c][t] -+ f1[c][t]) +- f1[c][t +
+// gap], for t = 0 .. count - 1 (- then + when the upper ends are the j ends). Two passes would
+// read back, one to three places over, a value just stored by a vector instruction, which the
+// processor cannot forward from its store buffer: a stall on every load.
+void add_both_shares(Index count, Index n, Index gap, const double* __restrict f1,
+                     double* __restrict f, bool upper_is_j) {
+  for (int c = 0; c < 3; ++c) {
+    double* __restrict fc = f + c * n;
+    const double* __restrict up = f1 + c * kChunk;
+    const double* __restrict lo = up + gap;
+    if (upper_is_j) {
+      for (Index t = 0; t < count; ++t)
+        fc[t] = (fc[t] - up[t]) + lo[t];
+    } else {
+      for (Index t = 0; t < count; ++t)
+        fc[t] = (fc[t] + up[t]) - lo[t];
+    }
+  }
+}
+
 }  // namespace
 
 bool SpringDampers::adds_soa(const Particles& /*p*/) const {
@@ -196,11 +217,33 @@ void SpringDampers::add_run(const SpringRun& run, Index p_begin, Index p_end, co
     run_kernel(c1 - c0, n, x.data() + run.i0 + c0, x.data() + run.j0 + c0, v.data() + run.i0 + c0,
                v.data() + run.j0 + c0, springs_.ks.data() + k, springs_.kd.data() + k,
                springs_.l0.data() + k, f1, f1 + kChunk, f1 + 2 * kChunk);
-    // The upper ends' shares, then the lower ends'.
+    // Springs [u0, u1) of the chunk give upper ends their shares, [l0, l1) lower ends theirs.
+    // Upper end upper + t is lower end lower + t + gap: where both fall in this chunk, that
+    // particle takes both at once (upper first); the others take theirs one pass at a time.
+    const Index gap = upper - lower;
     const Index u0 = std::max(c0, up_begin), u1 = std::min(c1, up_end);
-    if (u0 < u1) add_shares(u1 - u0, n, f1 + (u0 - c0), f.data() + upper + u0, !upper_is_j);
     const Index l0 = std::max(c0, lo_begin), l1 = std::min(c1, lo_end);
-    if (l0 < l1) add_shares(l1 - l0, n, f1 + (l0 - c0), f.data() + lower + l0, upper_is_j);
+    const Index both0 = std::max(u0, l0 - gap), both1 = std::max(both0, std::min(u1, l1 - gap));
+    double* const f_upper = f.data() + upper;
+    double* const f_lower = f.data() + lower;
+    const auto upper_only = [&](Index t0, Index t1) {
+      if (t0 < t1) add_shares(t1 - t0, n, f1 + (t0 - c0), f_upper + t0, !upper_is_j);
+    };
+    const auto lower_only = [&](Index t0, Index t1) {
+      if (t0 < t1) add_shares(t1 - t0, n, f1 + (t0 - c0), f_lower + t0, upper_is_j);
+    };
+    if (both0 == both1) {
+      upper_only(u0, u1);
+      lower_only(l0, l1);
+      continue;
+    }
+    // Distinct particles in each of the three: upper shares whose lower partner is in another
+    // chunk, the particles with both, lower shares whose upper partner came in an earlier one.
+    upper_only(u0, both0);
+    upper_only(both1, u1);
+    add_both_shares(both1 - both0, n, gap, f1 + (both0 - c0), f_upper + both0, upper_is_j);
+    lower_only(l0, both0 + gap);
+    lower_only(both1 + gap, l1);
   }
 }
 
