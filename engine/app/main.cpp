@@ -41,16 +41,20 @@ constexpr int kBadScene = 2;  // the scene file is wrong; nothing was written
 constexpr int kBlewUp = 3;    // the simulation stopped; frames up to then were written
 constexpr int kNotDone = 4;   // an exercise kernel is still a stub
 
-// A progress bar on stderr, only when stderr is a terminal and the run lasts a moment.
+// A progress bar on stderr, only when stderr is a terminal and the run lasts a moment: half a
+// second, or the seconds in the environment variable CLOTHLAB_PROGRESS_AFTER (the tests set 0,
+// so that a short run shows it too).
 class ProgressBar {
  public:
-  ProgressBar() : enabled_(isatty(STDERR_FILENO) != 0) {}
+  ProgressBar() : enabled_(isatty(STDERR_FILENO) != 0) {
+    if (const char* after = std::getenv("CLOTHLAB_PROGRESS_AFTER")) after_ = std::atof(after);
+  }
   void operator()(long done, long total) {
     if (!enabled_) return;
     const auto now = std::chrono::steady_clock::now();
     const double elapsed = std::chrono::duration<double>(now - start_).count();
     // Nothing for a run that ends within half a second; then at most ten updates a second.
-    if (elapsed < 0.5) return;
+    if (elapsed < after_) return;
     if (done != total && now - last_ < std::chrono::milliseconds(100)) return;
     last_ = now;
     shown_ = true;
@@ -64,6 +68,7 @@ class ProgressBar {
 
  private:
   bool enabled_;
+  double after_ = 0.5;  // [s] of wall time before the bar shows
   bool shown_ = false;
   std::chrono::steady_clock::time_point start_ = std::chrono::steady_clock::now();
   std::chrono::steady_clock::time_point last_ = start_;
