@@ -438,12 +438,14 @@ int bench_speed(SpeedOptions opt) {
   const int all_cores = opt.threads > 0 ? opt.threads : ThreadTeam::hardware_threads();
   fmt::print(
       "bench speed: N x N cloth, structural + shear + bending springs, gravity, symplectic Euler, "
-      "two pinned corners\n  {} build, {}; median of {} repeats of at least {} s; 1 thread and "
-      "{} (all cores)\n\n",
+      "two pinned corners\n  {} build, {}; median of {} repeats of at least {} s; 1 thread{}\n\n",
       kKernels,
       kLinkTimeOptimised ? "kernels inlined by link-time optimisation"
                          : "link-time optimisation off",
-      opt.repeats, opt.min_seconds, all_cores);
+      opt.repeats, opt.min_seconds,
+      all_cores <= 1    ? std::string()
+      : opt.threads > 0 ? fmt::format(" and {} (--threads)", all_cores)
+                        : fmt::format(" and {} (every core)", all_cores));
   std::vector<Measurement> rows;
   for (int n : opt.sizes)
     measure_size(n, all_cores, opt, rows);
