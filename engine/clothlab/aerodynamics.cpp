@@ -21,8 +21,8 @@ void FluidDrag::add_forces(const Particles& p, const Matrix3X& /*x*/, const Matr
 }
 
 void FluidDrag::add_forces_soa(const Particles& /*p*/, const SoA3& /*x*/, const SoA3& v, SoA3& f,
-                               ThreadTeam* /*team*/) const {
-  for (Index i = 0; i < f.cols(); ++i)
+                               Index begin, Index end) const {
+  for (Index i = begin; i < end; ++i)
     f.col(i) += fluid_drag_force(v.col(i), v_air_, rho_, cd_, area_);
 }
 

@@ -77,8 +77,8 @@ class FluidDrag final : public ForceEffect {
   }
   // The fast path (fast_forces.hpp): the same force on the structure-of-arrays state.
   bool adds_soa(const Particles& /*p*/) const override { return true; }
-  void add_forces_soa(const Particles& p, const SoA3& x, const SoA3& v, SoA3& f,
-                      ThreadTeam* team) const override;
+  void add_forces_soa(const Particles& p, const SoA3& x, const SoA3& v, SoA3& f, Index begin,
+                      Index end) const override;
 
  private:
   double rho_;   // fluid density [kg/m^3]

@@ -23,8 +23,8 @@ class Damping final : public ForceEffect {
                      ForceJacobians& jacobians) const override;
   // The fast path (fast_forces.hpp): the same force on the structure-of-arrays state.
   bool adds_soa(const Particles& /*p*/) const override { return true; }
-  void add_forces_soa(const Particles& p, const SoA3& x, const SoA3& v, SoA3& f,
-                      ThreadTeam* team) const override;
+  void add_forces_soa(const Particles& p, const SoA3& x, const SoA3& v, SoA3& f, Index begin,
+                      Index end) const override;
 
  private:
   double rate_;  // damping rate [1/s]

@@ -38,10 +38,11 @@ class ForceJacobians {
 // Per-particle vectors stored as a structure of arrays for the fast path (fast_forces.hpp): the
 // x components of every particle, then the y components, then the z components, each row
 // contiguous. Column i is still particle i (s.col(i) is a Vec3 expression), but a loop over
-// particles reads each component in memory order, which lets the compiler vectorise it.
+// particles reads each component in memory order, which lets the compiler vectorise it. The fast
+// path's copies have a few more columns than there are particles (fast_forces.cpp says why), so
+// row c of s starts at s.data() + c * s.cols(): use s.cols() as the stride, never the number
+// of particles.
 using SoA3 = Eigen::Matrix<double, 3, Eigen::Dynamic, Eigen::RowMajor>;
-
-class ThreadTeam;
 
 class ForceEffect {
  public:
@@ -91,11 +92,12 @@ class ForceEffect {
   // per evaluation, on one thread). The others make the world take the readable path.
   virtual bool adds_soa(const Particles& /*p*/) const { return false; }
 
-  // The same forces as add_forces, added into f, with the same floating-point operations on
-  // each particle in the same order, so that the two paths agree bit for bit. `team` (null for
-  // one thread) may share the work; the result must not depend on how many threads it has.
+  // The same forces as add_forces on particles [begin, end) only, added into those columns of
+  // f, with the same floating-point operations on each particle in the same order, so that the
+  // two paths agree bit for bit. It reads x and v anywhere (a spring reaches out of the range)
+  // and writes f nowhere else: the fast path gives different ranges to different threads.
   virtual void add_forces_soa(const Particles& /*p*/, const SoA3& /*x*/, const SoA3& /*v*/,
-                              SoA3& /*f*/, ThreadTeam* /*team*/) const {}
+                              SoA3& /*f*/, Index /*begin*/, Index /*end*/) const {}
 };
 
 class PostStepEffect {

@@ -12,11 +12,14 @@ template <class Kernel>
 void euler_advance(World& world, double dt, Kernel kernel) {
   Particles& p = world.particles;
   world.compute_forces(p.x, p.v, p.f);
-  for (Index i = 0; i < p.size(); ++i) {
-    const PointState next = kernel(p.x.col(i), p.v.col(i), p.f.col(i), p.inv_m[i], dt);
-    p.x.col(i) = next.r;
-    p.v.col(i) = next.v;
-  }
+  // Each particle moves by its own force, so threads may share the loop (World::threads).
+  world.for_particles([&](Index begin, Index end) {
+    for (Index i = begin; i < end; ++i) {
+      const PointState next = kernel(p.x.col(i), p.v.col(i), p.f.col(i), p.inv_m[i], dt);
+      p.x.col(i) = next.r;
+      p.v.col(i) = next.v;
+    }
+  });
 }
 
 }  // namespace

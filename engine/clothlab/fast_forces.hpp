@@ -9,7 +9,8 @@
 //   2. every effect adds its forces there (ForceEffect::add_forces_soa): a loop over particles,
 //      or over a run of springs (spring_damper.hpp), reads each component in memory order, so
 //      the compiler computes four springs at once with vector instructions, through the same
-//      exercise kernels;
+//      exercise kernels. With threads, each takes a contiguous range of particles and every
+//      effect adds the forces on that range only: no two threads write the same force;
 //   3. copy f back.
 //
 // Each particle receives the same floating-point operations in the same order as on the readable
@@ -25,6 +26,7 @@
 namespace clothlab {
 
 class World;
+class ThreadTeam;
 
 // The fast path's copies of the state, kept by the world between evaluations.
 struct FastScratch {

@@ -1,6 +1,7 @@
 #include "clothlab/guard.hpp"
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 
 #include <fmt/format.h>
@@ -11,12 +12,13 @@ namespace clothlab {
 
 namespace {
 
-// Whether |a| <= bound for every entry of m (false if any is NaN). The loop has no early exit,
-// so the compiler checks several entries at once; a state that passes reads every one anyway.
-bool all_within(const Matrix3X& m, double bound) {
+// Whether |a| <= bound for every entry of columns [begin, end) of m (false if any is NaN). The
+// loop has no early exit, so the compiler checks several entries at once; a state that passes
+// reads every one anyway.
+bool all_within(const Matrix3X& m, Index begin, Index end, double bound) {
   const double* a = m.data();
   long outside = 0;
-  for (Index k = 0; k < m.size(); ++k)
+  for (Index k = 3 * begin; k < 3 * end; ++k)
     outside += !(std::abs(a[k]) <= bound);
   return outside == 0;
 }
@@ -39,8 +41,12 @@ void Guard::check(const World& world, bool before_step) const {
   // Fast path: one vectorised pass over each array. |a| <= bound is false for a NaN (every
   // comparison with NaN is false), so this one test catches NaN, infinity and runaway values.
   // Only a failing state pays for the search that finds which particle went wrong.
-  const bool x_ok = all_within(p.x, max_position);
-  const bool v_ok = all_within(p.v, max_speed);
+  // Threads (World::threads) may share it, each checking a range of particles.
+  std::atomic<bool> x_ok = true, v_ok = true;
+  world.for_particles([&](Index begin, Index end) {
+    if (!all_within(p.x, begin, end, max_position)) x_ok = false;
+    if (!all_within(p.v, begin, end, max_speed)) v_ok = false;
+  });
   if (x_ok && v_ok) return;
 
   const bool position_bad = !x_ok;

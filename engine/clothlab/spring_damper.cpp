@@ -4,7 +4,6 @@
 #include <atomic>
 #include <cassert>
 
-#include "clothlab/threads.hpp"
 #include "clothlab/world.hpp"
 
 namespace clothlab {
@@ -124,20 +123,21 @@ namespace {
 constexpr Index kChunk = 256;  // springs per chunk: f1 of a chunk takes 6 KiB
 
 // The forces f1 of springs t = 0 .. count - 1 of a run: spring t joins the particles whose
-// components sit at x1[t], x1[t + n], x1[t + 2n] and x2[t], ... (n: particles in all), and its f1
-// goes to f1x[t], f1y[t], f1z[t]. A function of its own, not inlined, so that every pointer can
-// be declared not to overlap the others: then the compiler vectorises the loop, kernel inlined.
-[[gnu::noinline]] void run_kernel(Index count, Index n, const double* __restrict x1,
+// components sit at x1[t], x1[t + nx], x1[t + 2 nx] and x2[t], ..., with velocities at v1[t],
+// v1[t + nv], ... (nx, nv: the rows' strides), and its f1 goes to f1x[t], f1y[t], f1z[t]. A
+// function of its own, not inlined, so that every pointer can be declared not to overlap the
+// others: then the compiler vectorises the loop, kernel inlined.
+[[gnu::noinline]] void run_kernel(Index count, Index nx, Index nv, const double* __restrict x1,
                                   const double* __restrict x2, const double* __restrict v1,
                                   const double* __restrict v2, const double* __restrict ks,
                                   const double* __restrict kd, const double* __restrict l0,
                                   double* __restrict f1x, double* __restrict f1y,
                                   double* __restrict f1z) {
   for (Index t = 0; t < count; ++t) {
-    const Vec3 f1 = spring_damper_force(Vec3(x1[t], x1[n + t], x1[2 * n + t]),
-                                        Vec3(x2[t], x2[n + t], x2[2 * n + t]),
-                                        Vec3(v1[t], v1[n + t], v1[2 * n + t]),
-                                        Vec3(v2[t], v2[n + t], v2[2 * n + t]), ks[t], kd[t], l0[t]);
+    const Vec3 f1 = spring_damper_force(
+        Vec3(x1[t], x1[nx + t], x1[2 * nx + t]), Vec3(x2[t], x2[nx + t], x2[2 * nx + t]),
+        Vec3(v1[t], v1[nv + t], v1[2 * nv + t]), Vec3(v2[t], v2[nv + t], v2[2 * nv + t]), ks[t],
+        kd[t], l0[t]);
     f1x[t] = f1.x();
     f1y[t] = f1.y();
     f1z[t] = f1.z();
@@ -200,7 +200,7 @@ bool SpringDampers::adds_soa(const Particles& /*p*/) const {
 
 void SpringDampers::add_run(const SpringRun& run, Index p_begin, Index p_end, const SoA3& x,
                             const SoA3& v, SoA3& f) const {
-  const Index n = x.cols();
+  const Index n = f.cols();  // the stride of f's rows (of x's: x.cols(), of v's: v.cols())
   const Index lower = std::min(run.i0, run.j0), upper = std::max(run.i0, run.j0);
   const auto in_run = [&](Index t) { return std::clamp<Index>(t, 0, run.length); };
   // The springs with an upper end in [p_begin, p_end), and those with a lower end there.
@@ -214,9 +214,9 @@ void SpringDampers::add_run(const SpringRun& run, Index p_begin, Index p_end, co
   for (Index c0 = first; c0 < last; c0 += kChunk) {
     const Index c1 = std::min(c0 + kChunk, last);
     const Index k = static_cast<Index>(run.k0) + c0;
-    run_kernel(c1 - c0, n, x.data() + run.i0 + c0, x.data() + run.j0 + c0, v.data() + run.i0 + c0,
-               v.data() + run.j0 + c0, springs_.ks.data() + k, springs_.kd.data() + k,
-               springs_.l0.data() + k, f1, f1 + kChunk, f1 + 2 * kChunk);
+    run_kernel(c1 - c0, x.cols(), v.cols(), x.data() + run.i0 + c0, x.data() + run.j0 + c0,
+               v.data() + run.i0 + c0, v.data() + run.j0 + c0, springs_.ks.data() + k,
+               springs_.kd.data() + k, springs_.l0.data() + k, f1, f1 + kChunk, f1 + 2 * kChunk);
     // Springs [u0, u1) of the chunk give upper ends their shares, [l0, l1) lower ends theirs.
     // Upper end upper + t is lower end lower + t + gap: where both fall in this chunk, that
     // particle takes both at once (upper first); the others take theirs one pass at a time.
@@ -248,11 +248,9 @@ void SpringDampers::add_run(const SpringRun& run, Index p_begin, Index p_end, co
 }
 
 void SpringDampers::add_forces_soa(const Particles& /*p*/, const SoA3& x, const SoA3& v, SoA3& f,
-                                   ThreadTeam* team) const {
-  for_ranges(team, f.cols(), [&](Index p_begin, Index p_end) {
-    for (const SpringRun& run : layout_.runs)
-      add_run(run, p_begin, p_end, x, v, f);
-  });
+                                   Index begin, Index end) const {
+  for (const SpringRun& run : layout_.runs)
+    add_run(run, begin, end, x, v, f);
 }
 
 double SpringDampers::potential_energy(const Particles& /*p*/, const Matrix3X& x) const {

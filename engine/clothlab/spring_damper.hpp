@@ -115,8 +115,8 @@ class SpringDampers final : public ForceEffect {
   // The fast path (fast_forces.hpp): the same forces, run by run (see SpringRun). A set that
   // forms few runs (springs listed in no particular order) is left to add_forces.
   bool adds_soa(const Particles& p) const override;
-  void add_forces_soa(const Particles& p, const SoA3& x, const SoA3& v, SoA3& f,
-                      ThreadTeam* team) const override;
+  void add_forces_soa(const Particles& p, const SoA3& x, const SoA3& v, SoA3& f, Index begin,
+                      Index end) const override;
 
  private:
   // Adds the forces of the springs of `run` on the particles [p_begin, p_end) to f.

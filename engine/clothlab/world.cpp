@@ -71,6 +71,10 @@ void World::compute_forces(const Matrix3X& x, const Matrix3X& v, Matrix3X& f) co
   fast_forces(*this, x, v, f, fast_, team());
 }
 
+void World::for_particles(const std::function<void(Index begin, Index end)>& range) const {
+  for_ranges(team(), particles.size(), range);
+}
+
 void World::compute_forces_readable(const Matrix3X& x, const Matrix3X& v, Matrix3X& f) const {
   f.setZero();
   ++force_evaluations;

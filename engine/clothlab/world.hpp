@@ -8,6 +8,7 @@
 //   5. the guard checks that the state is still finite and bounded.
 #pragma once
 
+#include <functional>
 #include <memory>
 #include <string>
 #include <vector>
@@ -65,6 +66,11 @@ class World {
 
   // The lecture's loop, the one the lessons show: clear f, then each effect adds its forces.
   void compute_forces_readable(const Matrix3X& x, const Matrix3X& v, Matrix3X& f) const;
+
+  // Calls range(begin, end) on contiguous ranges of particles that cover them all once, each
+  // range on one of the `threads` threads: for loops over particles whose iterations are
+  // independent (an integrator moving each particle by its own force).
+  void for_particles(const std::function<void(Index begin, Index end)>& range) const;
 
   // Diagnostics of the current state.
   double kinetic_energy() const;    // sum of 1/2 m |v|^2 [J] (pinned particles do not move)

@@ -15,6 +15,7 @@
 #include <cmath>
 #include <cstring>
 #include <functional>
+#include <initializer_list>
 #include <iterator>
 #include <limits>
 #include <memory>
@@ -24,6 +25,7 @@
 #include <sstream>
 #include <stdexcept>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "clothlab/aerodynamics.hpp"
@@ -41,6 +43,16 @@ namespace {
 // Every integrator a scene may name.
 std::vector<std::string> all_integrators() {
   return {clothlab::integrator_names().begin(), clothlab::integrator_names().end()};
+}
+
+// Every integrator with every thread count of `threads`: (method, threads) pairs.
+std::vector<std::pair<std::string, int>> each_integrator_with(std::initializer_list<int> threads) {
+  std::vector<std::pair<std::string, int>> pairs;
+  for (const std::string& method : all_integrators()) {
+    for (int t : threads)
+      pairs.emplace_back(method, t);
+  }
+  return pairs;
 }
 
 // `text` must end inside its [integrator] table: the method is appended to it.
@@ -959,7 +971,8 @@ TEST_CASE("hard case: a NaN position in a cloth is caught at the next step namin
   // the lowest bad index (13 here, 0 with RK4) would be named instead of the one that went bad.
   //
   // Particle 20 (row 3, column 2 of a 6 x 6 cloth) gets a NaN x coordinate after step 10. The
-  // run must stop in step 11 with a SimulationError naming particle 20 and step 11.
+  // run must stop in step 11 with a SimulationError naming particle 20 and step 11, on one
+  // thread and on two (each thread checks half the particles: 20 is in the second half).
   const std::string text = R"(
 [cloth]
 rows = 6
@@ -976,10 +989,12 @@ dt = 0.001
 duration = 1
 )";
   const Index victim = 20;
-  for (const std::string& method : all_integrators()) {
+  for (const auto& [method, threads] : each_integrator_with({1, 2})) {
     CAPTURE(method);
+    CAPTURE(threads);
     clothlab::Scene scene = scene_with(text, method);
     clothlab::World& world = scene.world;
+    world.threads = threads;
     for (int s = 0; s < 10; ++s)
       world.step(scene.dt);
     world.particles.x(0, victim) = std::numeric_limits<double>::quiet_NaN();
