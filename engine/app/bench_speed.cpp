@@ -130,12 +130,21 @@ void time_steps(std::vector<Contender>& contenders, const SpeedOptions& opt) {
   using Clock = std::chrono::steady_clock;
   std::vector<long> steps;
   for (Contender& c : contenders) {
-    const Clock::time_point start = Clock::now();
     c.step();  // warm up: caches, the first step's guard setup, the threads
     c.step();
-    const double first = std::chrono::duration<double>(Clock::now() - start).count() / 2.0;
+    // The time of a step, from batches of 1, 2, 4, ... steps until one lasts a twentieth of a
+    // repeat (the first steps alone would overstate it: they set things up).
+    double per_step = 0.0;
+    for (long batch = 1;; batch *= 2) {
+      const Clock::time_point start = Clock::now();
+      for (long s = 0; s < batch; ++s)
+        c.step();
+      const double seconds = std::chrono::duration<double>(Clock::now() - start).count();
+      per_step = seconds / static_cast<double>(batch);
+      if (seconds >= opt.min_seconds / 20 || batch >= 1'000'000) break;
+    }
     steps.push_back(
-        std::clamp<long>(std::lround(opt.min_seconds / std::max(first, 1e-9)), 2, 10'000'000));
+        std::clamp<long>(std::lround(opt.min_seconds / std::max(per_step, 1e-9)), 2, 10'000'000));
   }
   for (int r = 0; r < opt.repeats; ++r) {
     for (size_t k = 0; k < contenders.size(); ++k) {
