@@ -5,11 +5,13 @@
 
 #include <algorithm>
 #include <atomic>
+#include <memory>
 #include <numeric>
 #include <random>
 #include <set>
 #include <stdexcept>
 #include <string>
+#include <string_view>
 #include <utility>
 #include <vector>
 
@@ -25,9 +27,9 @@ using clothlab::Matrix3X;
 namespace {
 
 // A cloth of rows x cols hanging from its top corners, with every effect that has a fast path,
-// aerodynamics (which has none: f goes back and forth between the layouts) between them, and
-// `extra` tables. Its column springs form a run of 44 x 41 = 1804 springs, seven chunks and a
-// short one (spring_damper.cpp).
+// aerodynamics and buoyancy (which have none: f goes back and forth between the layouts) among
+// them, and `extra` tables. Its column springs form a run of 44 x 41 = 1804 springs, seven chunks
+// and a short one (spring_damper.cpp).
 std::string cloth(const std::string& extra, const std::string& method = "symplectic-euler",
                   Index rows = 45, Index cols = 41) {
   return "[cloth]\nrows = " + std::to_string(rows) + "\ncols = " + std::to_string(cols) +
@@ -50,6 +52,9 @@ rate = 0.05
 wind = [3, 0, 2]
 [drag]
 area = 0.0004
+[buoyancy]
+volume = 1e-7
+surface = -0.3
 [ground]
 y = -0.6
 [integrator]
@@ -155,6 +160,53 @@ TEST_CASE("fast path: forces of one evaluation equal the readable path's, bit fo
   w.compute_forces_readable(w.particles.x, w.particles.v, f_readable);
   w.compute_forces(w.particles.x, w.particles.v, f_fast);
   CHECK(identical(f_fast, f_readable));
+}
+
+namespace {
+
+// A force without a fast path, for putting one between effects that have one: a weak pull of
+// every particle toward the origin.
+class PullToOrigin final : public clothlab::ForceEffect {
+ public:
+  std::string_view name() const override { return "pull"; }
+  void add_forces(const clothlab::Particles& p, const Matrix3X& x, const Matrix3X& /*v*/,
+                  Matrix3X& f) const override {
+    for (Index i = 0; i < p.size(); ++i)
+      f.col(i) -= 0.01 * x.col(i);
+  }
+};
+
+}  // namespace
+
+TEST_CASE("fast path: effects without a fast path, between and after those with one") {
+  // The scene's own order puts buoyancy (no fast path) last; the pull goes in after the
+  // springs, so f moves to the engine's layout and back twice within one evaluation.
+  const std::string text = cloth("");
+  for (int threads : {1, 2}) {
+    CAPTURE(threads);
+    std::vector<clothlab::Scene> scenes;
+    for (bool fast : {false, true}) {
+      clothlab::Scene scene = clothlab::parse_scene(text, "fast-path.toml");
+      auto& effects = scene.world.force_effects;
+      effects.insert(effects.begin() + 1, std::make_unique<PullToOrigin>());
+      scene.world.fast_path = fast;
+      scene.world.threads = threads;
+      for (int s = 0; s < 100; ++s)
+        scene.world.step(scene.dt);
+      scenes.push_back(std::move(scene));
+    }
+    const clothlab::World& readable = scenes[0].world;
+    const clothlab::World& fast = scenes[1].world;
+    std::string soa;  // which effects have a fast path, in the world's order
+    for (const auto& e : fast.force_effects)
+      soa += std::string(e->name()) + (e->adds_soa(fast.particles) ? "+ " : "- ");
+    CHECK(soa == "springs+ pull- bending+ damping+ gravity+ aerodynamics- drag+ buoyancy- ");
+    CHECK(fast.fast_evaluations == fast.force_evaluations);
+    CHECK(identical(fast.particles.x, readable.particles.x));
+    CHECK(identical(fast.particles.v, readable.particles.v));
+    // Buoyancy acts: part of the cloth is below its surface.
+    CHECK(fast.particles.x.row(1).minCoeff() < -0.3);
+  }
 }
 
 TEST_CASE("fast path: 2, 3 and 4 threads give the 1-thread state bit for bit") {
