@@ -37,9 +37,9 @@ std::filesystem::path lesson_file(const char* name) {
 }
 
 SpringSet& springs_of(World& world) {
-  for (auto& effect : world.force_effects)
-    if (effect->name() == "springs") return dynamic_cast<SpringDampers&>(*effect).springs();
-  throw std::runtime_error("the scene has no [springs]");
+  SpringDampers* springs = find_spring_effect(world, "springs");
+  if (!springs) throw std::runtime_error("the scene has no [springs]");
+  return springs->springs();
 }
 
 const Tearing* tearing_of(const World& world) {
