@@ -53,7 +53,7 @@ class World {
   StepTimes* timing = nullptr;
 
   // How the engine runs ([engine] in a scene, `clothlab run --threads N`).
-  int threads = 1;        // threads a force evaluation may use; 1: the calling thread only
+  int threads = 1;        // threads a step may use (fast path, Euler, guard); 1: this one only
   bool fast_path = true;  // false: every force evaluation takes the readable path
 
   // Takes one step of dt [s] (steps 1-5 above).
@@ -82,7 +82,7 @@ class World {
 
  private:
   bool takes_fast_path() const { return fast_path && !timing; }
-  ThreadTeam* team() const;  // the threads of the fast path, or null for one thread
+  ThreadTeam* team() const;  // the threads of a step, or null for one thread
 
   mutable std::unique_ptr<ThreadTeam> team_;
   mutable FastScratch fast_;
