@@ -114,6 +114,10 @@ void SpringDampers::add_forces(const Particles& /*p*/, const Matrix3X& x, const 
 // particle p is the upper end of spring p - U0 and the lower end of spring p - L0, which comes
 // later: in a later chunk, or in the same chunk, where upper ends go first.
 //
+// Runs whose ends lie kDirectGap or more particles apart (a grid's columns and diagonals) need no
+// buffer: each spring's f1 goes straight to both ends (run_kernel_direct below says why the
+// order of the sums stays the same).
+//
 // With several threads, each owns a contiguous range of particles and adds only to those: it
 // takes every spring with an end in its range. A spring between two ranges is computed by both
 // threads (the same bits twice); nothing is shared, so there are no locks and no atomics.
@@ -141,6 +145,54 @@ constexpr Index kChunk = 256;  // springs per chunk: f1 of a chunk takes 6 KiB
     f1x[t] = f1.x();
     f1y[t] = f1.y();
     f1z[t] = f1.z();
+  }
+}
+
+// Runs whose two ends are at least kDirectGap particles apart (a grid's column, diagonal and
+// column-bending springs) skip the buffer: each spring's f1 goes straight to both its ends.
+// Spring t writes the forces on particles lower + t and upper + t = lower + t + gap; a particle
+// that is the upper end of spring t is the lower end of spring t + gap. The compiler is told
+// that the loop's passes are independent: true as long as it takes fewer than gap springs at
+// once, and it takes 4 (AVX2) or 8 (AVX-512). Each particle then gets its two shares in separate
+// passes, upper first, as on the readable path, and nothing is stored only to be read back.
+constexpr Index kDirectGap = SpringDampers::kDirectGap;
+
+// Springs t = 0 .. count - 1 of a run (inputs as in run_kernel), their forces added to the
+// upper ends (f_upper[c n + t], if ToUpper) and the lower ends (f_lower[c n + t], if ToLower):
+// +f1 to the i end and -f1 to the j end. f_upper and f_lower point into the same array,
+// kDirectGap or more apart, which is why they are not restrict. `flatten` asks for the kernel
+// inlined at link time, as in run_kernel: for these six instances GCC declines otherwise.
+template <bool UpperIsJ, bool ToUpper, bool ToLower>
+[[gnu::noinline, gnu::flatten]] void run_kernel_direct(
+    Index count, Index nx, Index nv, Index n, const double* __restrict x1,
+    const double* __restrict x2, const double* __restrict v1, const double* __restrict v2,
+    const double* __restrict ks, const double* __restrict kd, const double* __restrict l0,
+    double* f_upper, double* f_lower) {
+  // No two springs the compiler takes at once touch the same particle (see kDirectGap).
+#if defined(__clang__)
+#pragma clang loop vectorize(assume_safety)
+#elif defined(__GNUC__)
+#pragma GCC ivdep
+#endif
+  for (Index t = 0; t < count; ++t) {
+    const Vec3 f1 = spring_damper_force(
+        Vec3(x1[t], x1[nx + t], x1[2 * nx + t]), Vec3(x2[t], x2[nx + t], x2[2 * nx + t]),
+        Vec3(v1[t], v1[nv + t], v1[2 * nv + t]), Vec3(v2[t], v2[nv + t], v2[2 * nv + t]), ks[t],
+        kd[t], l0[t]);
+    // The i end gets +f1, the j end -f1. Component by component, written out: the compiler
+    // keeps f1 in registers only if no loop index picks its components.
+    double* const f_i = UpperIsJ ? f_lower : f_upper;
+    double* const f_j = UpperIsJ ? f_upper : f_lower;
+    if constexpr (UpperIsJ ? ToLower : ToUpper) {
+      f_i[t] += f1.x();
+      f_i[n + t] += f1.y();
+      f_i[2 * n + t] += f1.z();
+    }
+    if constexpr (UpperIsJ ? ToUpper : ToLower) {
+      f_j[t] -= f1.x();
+      f_j[n + t] -= f1.y();
+      f_j[2 * n + t] -= f1.z();
+    }
   }
 }
 
@@ -210,6 +262,10 @@ void SpringDampers::add_run(const SpringRun& run, Index p_begin, Index p_end, co
   const Index first = up_begin < up_end ? up_begin : lo_begin;
   const Index last = lo_begin < lo_end ? lo_end : up_end;
   const bool upper_is_j = run.j0 > run.i0;
+  if (upper - lower >= kDirectGap) {
+    add_run_direct(run, up_begin, up_end, lo_begin, lo_end, x, v, f);
+    return;
+  }
   double f1[3 * kChunk];
   for (Index c0 = first; c0 < last; c0 += kChunk) {
     const Index c1 = std::min(c0 + kChunk, last);
@@ -245,6 +301,37 @@ void SpringDampers::add_run(const SpringRun& run, Index p_begin, Index p_end, co
     lower_only(l0, both0 + gap);
     lower_only(both1 + gap, l1);
   }
+}
+
+void SpringDampers::add_run_direct(const SpringRun& run, Index up_begin, Index up_end,
+                                   Index lo_begin, Index lo_end, const SoA3& x, const SoA3& v,
+                                   SoA3& f) const {
+  const Index lower = std::min(run.i0, run.j0), upper = std::max(run.i0, run.j0);
+  const bool upper_is_j = run.j0 > run.i0;
+  // Springs [t0, t1) of the run, their forces added to the ends that are in range.
+  const auto springs = [&](Index t0, Index t1, bool to_upper, bool to_lower) {
+    if (t0 >= t1) return;
+    const Index k = static_cast<Index>(run.k0) + t0;
+    // run_kernel_direct<UpperIsJ, ToUpper, ToLower> by [upper_is_j][to_upper][to_lower].
+    using Kernel = decltype(&run_kernel_direct<false, true, true>);
+    static constexpr Kernel kernels[2][2][2] = {
+        {{nullptr, run_kernel_direct<false, false, true>},
+         {run_kernel_direct<false, true, false>, run_kernel_direct<false, true, true>}},
+        {{nullptr, run_kernel_direct<true, false, true>},
+         {run_kernel_direct<true, true, false>, run_kernel_direct<true, true, true>}}};
+    kernels[upper_is_j][to_upper][to_lower](
+        t1 - t0, x.cols(), v.cols(), f.cols(), x.data() + run.i0 + t0, x.data() + run.j0 + t0,
+        v.data() + run.i0 + t0, v.data() + run.j0 + t0, springs_.ks.data() + k,
+        springs_.kd.data() + k, springs_.l0.data() + k, f.data() + upper + t0,
+        f.data() + lower + t0);
+  };
+  // Spring t has its upper end in range for t in [up_begin, up_end) and its lower end for t in
+  // [lo_begin, lo_end), the same interval shifted by the gap (or clamped to the run). In the
+  // order of t: springs with only their upper end in range, then both, then only the lower.
+  const Index both_begin = std::max(up_begin, lo_begin), both_end = std::min(up_end, lo_end);
+  springs(up_begin, std::min(up_end, lo_begin), true, false);
+  springs(both_begin, both_end, true, true);
+  springs(std::max(up_end, lo_begin), lo_end, false, true);
 }
 
 void SpringDampers::add_forces_soa(const Particles& /*p*/, const SoA3& x, const SoA3& v, SoA3& f,

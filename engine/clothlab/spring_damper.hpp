@@ -113,7 +113,10 @@ class SpringDampers final : public ForceEffect {
   SpringSet& springs() { return springs_; }
 
   // The fast path (fast_forces.hpp): the same forces, run by run (see SpringRun). A set that
-  // forms few runs (springs listed in no particular order) is left to add_forces.
+  // forms few runs (springs listed in no particular order) is left to add_forces. A run whose
+  // ends are kDirectGap or more particles apart adds each force straight to both ends; closer
+  // ones go through a small buffer (spring_damper.cpp says why).
+  static constexpr Index kDirectGap = 16;
   bool adds_soa(const Particles& p) const override;
   void add_forces_soa(const Particles& p, const SoA3& x, const SoA3& v, SoA3& f, Index begin,
                       Index end) const override;
@@ -122,6 +125,11 @@ class SpringDampers final : public ForceEffect {
   // Adds the forces of the springs of `run` on the particles [p_begin, p_end) to f.
   void add_run(const SpringRun& run, Index p_begin, Index p_end, const SoA3& x, const SoA3& v,
                SoA3& f) const;
+  // The same for a run whose ends are kDirectGap or more apart (spring_damper.cpp), without the
+  // buffer: springs [up_begin, up_end) have their upper end in range, [lo_begin, lo_end) their
+  // lower end.
+  void add_run_direct(const SpringRun& run, Index up_begin, Index up_end, Index lo_begin,
+                      Index lo_end, const SoA3& x, const SoA3& v, SoA3& f) const;
 
   std::string name_;
   SpringSet springs_;

@@ -224,6 +224,25 @@ TEST_CASE("fast path: 2, 3 and 4 threads give the 1-thread state bit for bit") {
                   run(small, false, 1, 50).world.particles.x));
 }
 
+TEST_CASE("fast path: runs just below, at and above the gap where forces skip the buffer") {
+  // A cloth `cols` wide has column springs cols particles apart, diagonals cols - 1 and
+  // cols + 1, column bending 2 cols: around kDirectGap, the runs of one cloth take both ways
+  // (spring_damper.cpp), and a particle gets shares from both in one evaluation.
+  const Index gap = clothlab::SpringDampers::kDirectGap;
+  for (Index cols : {gap - 1, gap, gap + 1}) {
+    const std::string text = cloth("", "symplectic-euler", 12, cols);
+    const clothlab::Scene readable = run(text, false, 1, 80);
+    for (int threads : {1, 3}) {
+      CAPTURE(cols);
+      CAPTURE(threads);
+      const clothlab::Scene fast = run(text, true, threads, 80);
+      CHECK(fast.world.fast_evaluations == fast.world.force_evaluations);
+      CHECK(identical(fast.world.particles.x, readable.world.particles.x));
+      CHECK(identical(fast.world.particles.v, readable.world.particles.v));
+    }
+  }
+}
+
 TEST_CASE("fast path: tearing and plasticity on the runs layout match the readable path") {
   // A storm that stretches the sheet past its yield and tearing limits.
   const std::string text =
