@@ -10,14 +10,18 @@
 //   readable        the same step on the readable path ([engine] fast_path = false)
 //   naive           a lecture-style engine kept here: an array of particle objects, spring
 //                   objects holding pointers to their two particles, ComputeForce() per spring
+//   kernel          the spring kernel alone (spring_forces_of_run, the fast path's inner loop)
+//                   on 256 springs whose data stay in the first-level cache: the least any step
+//                   built on the lecture's kernel can cost per spring on this machine
 //   +aerodynamics   the reference with [aerodynamics] added, then [ground] as well
 //   student         the same scene in clothlab-student (your exercises), run as a subprocess;
 //                   skipped, saying which, while an exercise it needs is still a stub
 //   implicit        implicit Euler on a stiff cloth: the whole step, then its assembly (forces,
 //                   Jacobians, the matrix) and its linear solve
 //
-// All variants but `implicit` compute the same physics; the naive one is checked against the
-// engine after a few steps, and the readable and fast paths agree bit for bit (a test checks it).
+// All variants but `kernel` and `implicit` compute the same physics; the naive one is checked
+// against the engine after a few steps, and the readable and fast paths agree bit for bit (a
+// test checks it).
 #include <fcntl.h>
 #include <spawn.h>
 #include <sys/wait.h>
@@ -235,6 +239,49 @@ NaiveCloth naive_cloth(const World& world, int n) {
   return cloth;
 }
 
+// --- The kernel alone ------------------------------------------------------------------------
+//
+// Springs t = 0 .. count - 1 joining particles t and t + 1 of a cloth, in the fast path's layout,
+// evaluated by the fast path's own loop. 256 springs take 24 KiB (positions, velocities,
+// constants, forces), so everything stays in the first-level cache: the time is the kernel's
+// arithmetic alone.
+
+struct KernelRun {
+  static constexpr long kPasses = 16;  // evaluations of the run per timed "step"
+  long count = 0;
+  Index stride = 0;          // of the rows of x and v
+  std::vector<double> x, v;  // 3 rows of `stride` particles each
+  std::vector<double> ks, kd, l0, f1;
+
+  void evaluate() {
+    for (long pass = 0; pass < kPasses; ++pass) {
+      spring_forces_of_run(count, stride, stride, x.data(), x.data() + 1, v.data(), v.data() + 1,
+                           ks.data(), kd.data(), l0.data(), f1.data(), f1.data() + count,
+                           f1.data() + 2 * count);
+    }
+  }
+};
+
+KernelRun kernel_run(const World& world) {
+  const Particles& p = world.particles;
+  KernelRun run;
+  run.count = std::min<long>(256, static_cast<long>(p.size()) - 1);
+  run.stride = run.count + 1;
+  run.x.resize(static_cast<size_t>(3 * run.stride));
+  run.v.resize(run.x.size());
+  for (Index i = 0; i < run.stride; ++i) {
+    for (Index c = 0; c < 3; ++c) {
+      run.x[static_cast<size_t>(c * run.stride + i)] = p.x(c, i);
+      run.v[static_cast<size_t>(c * run.stride + i)] = p.v(c, i);
+    }
+  }
+  run.ks.assign(static_cast<size_t>(run.count), kKs);
+  run.kd.assign(static_cast<size_t>(run.count), kKd);
+  run.l0.assign(static_cast<size_t>(run.count), kSpacing);
+  run.f1.assign(static_cast<size_t>(3 * run.count), 0.0);
+  return run;
+}
+
 // --- The variants --------------------------------------------------------------------------
 
 bool wanted(const SpeedOptions& opt, const std::string& variant) {
@@ -294,6 +341,17 @@ void measure_size(int n, int all_cores, const SpeedOptions& opt, std::vector<Mea
                           [&naive, dt] { naive.Step(dt); },
                           {}});
     notes.push_back(fmt::format("agrees with reference to {:.1e} m after 20 steps", gap));
+  }
+  KernelRun kernel;
+  if (wanted(opt, "kernel")) {
+    Scene scene = parse_scene(cloth_scene(n, 1, true, ""), "<bench>");
+    for (int k = 0; k < 20; ++k)  // a cloth in motion: stretched springs, moving particles
+      scene.world.step(scene.dt);
+    kernel = kernel_run(scene.world);
+    contenders.push_back(
+        {"kernel", 1, KernelRun::kPasses * kernel.count, [&kernel] { kernel.evaluate(); }, {}});
+    notes.push_back(fmt::format("{} springs in the first-level cache, {} passes a \"step\"",
+                                kernel.count, KernelRun::kPasses));
   }
   const std::string aero = "[aerodynamics]\nwind = [2.0, 0.0, 1.0]\n";
   const std::string ground = "[ground]\ny = 0.5\ne = 0.2\nmu_s = 0.5\nmu_d = 0.3\n";
@@ -511,7 +569,7 @@ void add_bench_speed_command(CLI::App& bench) {
   speed->add_option("--csv", o.csv, "Write one row per measurement to this CSV file");
   speed
       ->add_option("--variants", o.variants,
-                   "Variants to measure (default: all): reference, readable, naive, "
+                   "Variants to measure (default: all): reference, readable, naive, kernel, "
                    "+aerodynamics, +aerodynamics+ground, implicit, student")
       ->delimiter(',');
   speed->add_flag("--quick", o.quick, "Sizes 16 and 32, one short repeat (for tests)");

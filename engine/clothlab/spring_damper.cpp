@@ -122,21 +122,13 @@ void SpringDampers::add_forces(const Particles& /*p*/, const Matrix3X& x, const 
 // takes every spring with an end in its range. A spring between two ranges is computed by both
 // threads (the same bits twice); nothing is shared, so there are no locks and no atomics.
 
-namespace {
-
-constexpr Index kChunk = 256;  // springs per chunk: f1 of a chunk takes 6 KiB
-
-// The forces f1 of springs t = 0 .. count - 1 of a run: spring t joins the particles whose
-// components sit at x1[t], x1[t + nx], x1[t + 2 nx] and x2[t], ..., with velocities at v1[t],
-// v1[t + nv], ... (nx, nv: the rows' strides), and its f1 goes to f1x[t], f1y[t], f1z[t]. A
-// function of its own, not inlined, so that every pointer can be declared not to overlap the
+// A function of its own, not inlined, so that every pointer can be declared not to overlap the
 // others: then the compiler vectorises the loop, kernel inlined.
-[[gnu::noinline]] void run_kernel(Index count, Index nx, Index nv, const double* __restrict x1,
-                                  const double* __restrict x2, const double* __restrict v1,
-                                  const double* __restrict v2, const double* __restrict ks,
-                                  const double* __restrict kd, const double* __restrict l0,
-                                  double* __restrict f1x, double* __restrict f1y,
-                                  double* __restrict f1z) {
+[[gnu::noinline]] void spring_forces_of_run(
+    Index count, Index nx, Index nv, const double* __restrict x1, const double* __restrict x2,
+    const double* __restrict v1, const double* __restrict v2, const double* __restrict ks,
+    const double* __restrict kd, const double* __restrict l0, double* __restrict f1x,
+    double* __restrict f1y, double* __restrict f1z) {
   for (Index t = 0; t < count; ++t) {
     const Vec3 f1 = spring_damper_force(
         Vec3(x1[t], x1[nx + t], x1[2 * nx + t]), Vec3(x2[t], x2[nx + t], x2[2 * nx + t]),
@@ -148,6 +140,10 @@ constexpr Index kChunk = 256;  // springs per chunk: f1 of a chunk takes 6 KiB
   }
 }
 
+namespace {
+
+constexpr Index kChunk = 256;  // springs per chunk: f1 of a chunk takes 6 KiB
+
 // Runs whose two ends are at least kDirectGap particles apart (a grid's column, diagonal and
 // column-bending springs) skip the buffer: each spring's f1 goes straight to both its ends.
 // Spring t writes the forces on particles lower + t and upper + t = lower + t + gap; a particle
@@ -157,11 +153,11 @@ constexpr Index kChunk = 256;  // springs per chunk: f1 of a chunk takes 6 KiB
 // passes, upper first, as on the readable path, and nothing is stored only to be read back.
 constexpr Index kDirectGap = SpringDampers::kDirectGap;
 
-// Springs t = 0 .. count - 1 of a run (inputs as in run_kernel), their forces added to the
-// upper ends (f_upper[c n + t], if ToUpper) and the lower ends (f_lower[c n + t], if ToLower):
+// Springs t = 0 .. count - 1 of a run (inputs as in spring_forces_of_run), their forces added to
+// the upper ends (f_upper[c n + t], if ToUpper) and the lower ends (f_lower[c n + t], if ToLower):
 // +f1 to the i end and -f1 to the j end. f_upper and f_lower point into the same array,
 // kDirectGap or more apart, which is why they are not restrict. `flatten` asks for the kernel
-// inlined at link time, as in run_kernel: for these six instances GCC declines otherwise.
+// inlined at link time, as in spring_forces_of_run: for these six instances GCC declines otherwise.
 template <bool UpperIsJ, bool ToUpper, bool ToLower>
 [[gnu::noinline, gnu::flatten]] void run_kernel_direct(
     Index count, Index nx, Index nv, Index n, const double* __restrict x1,
@@ -270,9 +266,10 @@ void SpringDampers::add_run(const SpringRun& run, Index p_begin, Index p_end, co
   for (Index c0 = first; c0 < last; c0 += kChunk) {
     const Index c1 = std::min(c0 + kChunk, last);
     const Index k = static_cast<Index>(run.k0) + c0;
-    run_kernel(c1 - c0, x.cols(), v.cols(), x.data() + run.i0 + c0, x.data() + run.j0 + c0,
-               v.data() + run.i0 + c0, v.data() + run.j0 + c0, springs_.ks.data() + k,
-               springs_.kd.data() + k, springs_.l0.data() + k, f1, f1 + kChunk, f1 + 2 * kChunk);
+    spring_forces_of_run(c1 - c0, x.cols(), v.cols(), x.data() + run.i0 + c0,
+                         x.data() + run.j0 + c0, v.data() + run.i0 + c0, v.data() + run.j0 + c0,
+                         springs_.ks.data() + k, springs_.kd.data() + k, springs_.l0.data() + k, f1,
+                         f1 + kChunk, f1 + 2 * kChunk);
     // Springs [u0, u1) of the chunk give upper ends their shares, [l0, l1) lower ends theirs.
     // Upper end upper + t is lower end lower + t + gap: where both fall in this chunk, that
     // particle takes both at once (upper first); the others take theirs one pass at a time.

@@ -87,6 +87,18 @@ struct SpringRun {
 // structure comes out as runs of length 1; the runs always cover every spring exactly once.
 std::vector<SpringRun> spring_runs(const SpringSet& s);
 
+// The fast path's inner loop: the forces f1 of springs t = 0 .. count - 1 of a run, through
+// spring_damper_force. Spring t joins the particles whose components sit at x1[t], x1[nx + t],
+// x1[2 nx + t] and x2[t], ... (nx: the stride of x's rows), with velocities at v1[t],
+// v1[nv + t], ...; its constants are ks[t], kd[t], l0[t], and f1 goes to f1x[t], f1y[t],
+// f1z[t]. No two arrays may overlap. Compiled with the kernel inlined (link-time optimisation),
+// it evaluates four springs at once; `clothlab bench speed` times it alone.
+void spring_forces_of_run(Index count, Index nx, Index nv, const double* __restrict x1,
+                          const double* __restrict x2, const double* __restrict v1,
+                          const double* __restrict v2, const double* __restrict ks,
+                          const double* __restrict kd, const double* __restrict l0,
+                          double* __restrict f1x, double* __restrict f1y, double* __restrict f1z);
+
 // The spring effect of `world` called `name` ("springs" or "bending"), or nullptr.
 SpringDampers* find_spring_effect(World& world, std::string_view name);
 
