@@ -151,7 +151,7 @@ constexpr Index kChunk = 256;  // springs per chunk: f1 of a chunk takes 6 KiB
 // that the loop's passes are independent: true as long as it takes fewer than gap springs at
 // once, and it takes 4 (AVX2) or 8 (AVX-512). Each particle then gets its two shares in separate
 // passes, upper first, as on the readable path, and nothing is stored only to be read back.
-constexpr Index kDirectGap = SpringDampers::kDirectGap;
+// (SpringDampers::kDirectGap; add_run takes this path for such runs.)
 
 // Springs t = 0 .. count - 1 of a run (inputs as in spring_forces_of_run), their forces added to
 // the upper ends (f_upper[c n + t], if ToUpper) and the lower ends (f_lower[c n + t], if ToLower):
@@ -164,8 +164,12 @@ template <bool UpperIsJ, bool ToUpper, bool ToLower>
     const double* __restrict x2, const double* __restrict v1, const double* __restrict v2,
     const double* __restrict ks, const double* __restrict kd, const double* __restrict l0,
     double* f_upper, double* f_lower) {
-  // No two springs the compiler takes at once touch the same particle (see kDirectGap).
+  // No two springs the compiler takes at once touch the same particle (see kDirectGap). Clang
+  // says so when it cannot vectorise the loop anyway, which is the case whenever the kernel is
+  // not inlined (a build without link-time optimisation): no reason for a warning.
 #if defined(__clang__)
+#pragma clang diagnostic push
+#pragma clang diagnostic ignored "-Wpass-failed"
 #pragma clang loop vectorize(assume_safety)
 #elif defined(__GNUC__)
 #pragma GCC ivdep
@@ -190,6 +194,9 @@ template <bool UpperIsJ, bool ToUpper, bool ToLower>
       f_j[2 * n + t] -= f1.z();
     }
   }
+#if defined(__clang__)
+#pragma clang diagnostic pop
+#endif
 }
 
 // f[c][t] += f1[c][t] (add) or -= (subtract), for t = 0 .. count - 1 and each component c;
@@ -255,13 +262,13 @@ void SpringDampers::add_run(const SpringRun& run, Index p_begin, Index p_end, co
   const Index up_begin = in_run(p_begin - upper), up_end = in_run(p_end - upper);
   const Index lo_begin = in_run(p_begin - lower), lo_end = in_run(p_end - lower);
   if (up_begin == up_end && lo_begin == lo_end) return;
-  const Index first = up_begin < up_end ? up_begin : lo_begin;
-  const Index last = lo_begin < lo_end ? lo_end : up_end;
-  const bool upper_is_j = run.j0 > run.i0;
   if (upper - lower >= kDirectGap) {
     add_run_direct(run, up_begin, up_end, lo_begin, lo_end, x, v, f);
     return;
   }
+  const Index first = up_begin < up_end ? up_begin : lo_begin;
+  const Index last = lo_begin < lo_end ? lo_end : up_end;
+  const bool upper_is_j = run.j0 > run.i0;
   double f1[3 * kChunk];
   for (Index c0 = first; c0 < last; c0 += kChunk) {
     const Index c1 = std::min(c0 + kChunk, last);
