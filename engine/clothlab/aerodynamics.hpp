@@ -50,6 +50,10 @@ class Aerodynamics final : public ForceEffect {
   double energy_scale(const Particles& p, const Matrix3X& /*x*/, double /*size*/) const override {
     return 0.5 * p.m.sum() * v_air_.squaredNorm();
   }
+  // The fast path (fast_forces.hpp): the same forces, the kernel on several triangles at once.
+  bool adds_soa(const Particles& /*p*/) const override { return true; }
+  void add_forces_soa(const Particles& p, const SoA3& x, const SoA3& v, SoA3& f, Index begin,
+                      Index end) const override;
   const std::vector<Triangle>& triangles() const { return triangles_; }
   // Drops the triangles a tear has opened (lesson 06).
   template <class Predicate>

@@ -15,8 +15,8 @@
 //
 // Each particle receives the same floating-point operations in the same order as on the readable
 // path, so the two agree bit for bit, with any number of threads (tests/engine/fast_path.cpp).
-// An effect without such a path (aerodynamics on triangles, gravitation) adds its forces with
-// add_forces, on the engine's layout, in its turn: f is copied across when the layout changes.
+// An effect without such a path (buoyancy, gravitation) adds its forces with add_forces, on the
+// engine's layout, in its turn: f is copied across when the layout changes.
 #pragma once
 
 #include <vector>

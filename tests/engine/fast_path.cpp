@@ -27,9 +27,8 @@ using clothlab::Matrix3X;
 namespace {
 
 // A cloth of rows x cols hanging from its top corners, with every effect that has a fast path,
-// aerodynamics and buoyancy (which have none: f goes back and forth between the layouts) among
-// them, and `extra` tables. Its column springs form a run of 44 x 41 = 1804 springs, seven chunks
-// and a short one (spring_damper.cpp).
+// buoyancy (which has none: f goes back and forth between the layouts) among them, and `extra`
+// tables. Its column springs form a run of 44 x 41 = 1804 springs.
 std::string cloth(const std::string& extra, const std::string& method = "symplectic-euler",
                   Index rows = 45, Index cols = 41) {
   return "[cloth]\nrows = " + std::to_string(rows) + "\ncols = " + std::to_string(cols) +
@@ -200,7 +199,7 @@ TEST_CASE("fast path: effects without a fast path, between and after those with 
     std::string soa;  // which effects have a fast path, in the world's order
     for (const auto& e : fast.force_effects)
       soa += std::string(e->name()) + (e->adds_soa(fast.particles) ? "+ " : "- ");
-    CHECK(soa == "springs+ pull- bending+ damping+ gravity+ aerodynamics- drag+ buoyancy- ");
+    CHECK(soa == "springs+ pull- bending+ damping+ gravity+ aerodynamics+ drag+ buoyancy- ");
     CHECK(fast.fast_evaluations == fast.force_evaluations);
     CHECK(identical(fast.particles.x, readable.particles.x));
     CHECK(identical(fast.particles.v, readable.particles.v));
