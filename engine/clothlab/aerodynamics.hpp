@@ -16,6 +16,7 @@
 // triangle's winding flips n, but (v . n) n is unchanged, so the force does not depend on it.
 #pragma once
 
+#include <array>
 #include <vector>
 
 #include "clothlab/effect.hpp"
@@ -51,7 +52,11 @@ class Aerodynamics final : public ForceEffect {
     return 0.5 * p.m.sum() * v_air_.squaredNorm();
   }
   // The fast path (fast_forces.hpp): the same forces, the kernel on several triangles at once.
-  bool adds_soa(const Particles& /*p*/) const override { return true; }
+  bool adds_soa(const Particles& /*p*/) const override {
+    if (!groups_built_) groups_ = triangle_groups(triangles_);
+    groups_built_ = true;
+    return true;
+  }
   void add_forces_soa(const Particles& p, const SoA3& x, const SoA3& v, SoA3& f, Index begin,
                       Index end) const override;
   const std::vector<Triangle>& triangles() const { return triangles_; }
@@ -59,10 +64,34 @@ class Aerodynamics final : public ForceEffect {
   template <class Predicate>
   void remove_triangles_if(Predicate torn) {
     std::erase_if(triangles_, torn);
+    groups_built_ = false;
   }
 
+  // A stretch of the triangle list seen by the fast path (aerodynamics.cpp). In a run, the list's
+  // triangles k0, k0 + 1, ... alternate between `period` phases, and triangle i of phase p (list
+  // position k0 + period i + p) has corners base[p][0] + i, base[p][1] + i, base[p][2] + i: a
+  // grid's two triangles per cell along a row. Otherwise its triangles are taken one by one.
+  struct TriangleGroup {
+    size_t k0 = 0, size = 0;  // list positions [k0, k0 + size)
+    bool run = false;
+    int period = 1;    // phases (1 or 2)
+    Index length = 0;  // triangles per phase
+    std::array<Triangle, 2> base{};
+    // Corner shares in the order a particle receives them in the list: (phase, corner) pairs.
+    std::array<std::array<int, 2>, 6> order{};
+  };
+  // The triangle list cut into groups, in order, covering every triangle once.
+  static std::vector<TriangleGroup> triangle_groups(const std::vector<Triangle>& triangles);
+
  private:
+  void add_group_soa(const TriangleGroup& g, const SoA3& x, const SoA3& v, SoA3& f, Index begin,
+                     Index end) const;
+  void add_triangles_soa(size_t k_begin, size_t k_end, const SoA3& x, const SoA3& v, SoA3& f,
+                         Index begin, Index end) const;
+
   std::vector<Triangle> triangles_;
+  mutable std::vector<TriangleGroup> groups_;  // the fast path's view of triangles_
+  mutable bool groups_built_ = false;
   double rho_;  // air density [kg/m^3]
   double cd_;   // drag coefficient
   Vec3 v_air_;  // wind velocity [m/s]

@@ -15,6 +15,7 @@
 #include <utility>
 #include <vector>
 
+#include "clothlab/aerodynamics.hpp"
 #include "clothlab/bending.hpp"
 #include "clothlab/cloth.hpp"
 #include "clothlab/scene.hpp"
@@ -260,6 +261,75 @@ TEST_CASE("fast path: tearing and plasticity on the runs layout match the readab
   CHECK(identical(threaded.world.particles.x, readable.world.particles.x));
   CHECK(s.l0 == r.l0);  // plastic flow, spring by spring
   CHECK(pairs_of(s) == pairs_of(r));
+}
+
+TEST_CASE("fast path: a grid's triangles form one run per row, two triangles a cell") {
+  const Index rows = 5, cols = 12;  // runs of 11 cells: long enough to be worth one
+  const clothlab::Scene scene =
+      clothlab::parse_scene(cloth("", "symplectic-euler", rows, cols), "t");
+  const clothlab::Aerodynamics* aero = nullptr;
+  for (const auto& effect : scene.world.force_effects) {
+    if (effect->name() == "aerodynamics")
+      aero = dynamic_cast<const clothlab::Aerodynamics*>(effect.get());
+  }
+  REQUIRE(aero != nullptr);
+  const auto groups = clothlab::Aerodynamics::triangle_groups(aero->triangles());
+  REQUIRE(groups.size() == rows - 1);
+  size_t next = 0;
+  for (const auto& g : groups) {
+    CHECK(g.run);
+    CHECK(g.k0 == next);  // in order, each triangle once
+    CHECK(g.period == 2);
+    CHECK(g.length == cols - 1);
+    next += g.size;
+  }
+  CHECK(next == aero->triangles().size());
+  // Cell p has triangles (p, p + cols, p + 1) then (p + cols, p + cols + 1, p + 1): particle q
+  // gets its shares from (phase, corner) (1, 1), (0, 1), (1, 0), (0, 2), (1, 2), (0, 0), in the
+  // list's order (the triangles are q - cols - 1, q - cols, q - cols, q - 1, q - 1 and q).
+  const std::array<std::array<int, 2>, 6> order = {
+      {{1, 1}, {0, 1}, {1, 0}, {0, 2}, {1, 2}, {0, 0}}};
+  CHECK(groups[0].order == order);
+}
+
+TEST_CASE("fast path: triangles in other orders give the readable result") {
+  // The grid's triangles listed backwards (no runs: one by one), a row's first triangles before
+  // its second ones (runs of one phase), and shuffled, on 1 and 3 threads.
+  const std::string text = cloth("", "symplectic-euler", 12, 20);
+  for (const char* order : {"backwards", "by phase", "shuffled"}) {
+    for (int threads : {1, 3}) {
+      CAPTURE(order);
+      CAPTURE(threads);
+      std::vector<clothlab::Scene> scenes;
+      for (bool fast : {false, true}) {
+        clothlab::Scene scene = clothlab::parse_scene(text, "fast-path.toml");
+        for (auto& effect : scene.world.force_effects) {
+          const auto* aero = dynamic_cast<const clothlab::Aerodynamics*>(effect.get());
+          if (!aero) continue;
+          std::vector<clothlab::Triangle> t = aero->triangles();
+          if (std::string(order) == "backwards") {
+            std::reverse(t.begin(), t.end());
+          } else if (std::string(order) == "by phase") {
+            std::stable_partition(t.begin(), t.end(),
+                                  [](const auto& tri) { return tri[2] == tri[0] + 1; });
+          } else {
+            std::mt19937 random(7);
+            std::shuffle(t.begin(), t.end(), random);
+          }
+          effect =
+              std::make_unique<clothlab::Aerodynamics>(t, clothlab::kAirDensity, 1.2, aero->wind());
+        }
+        scene.world.fast_path = fast;
+        scene.world.threads = threads;
+        for (int step = 0; step < 60; ++step)
+          scene.world.step(scene.dt);
+        scenes.push_back(std::move(scene));
+      }
+      CHECK(scenes[1].world.fast_evaluations == scenes[1].world.force_evaluations);
+      CHECK(identical(scenes[1].world.particles.x, scenes[0].world.particles.x));
+      CHECK(identical(scenes[1].world.particles.v, scenes[0].world.particles.v));
+    }
+  }
 }
 
 TEST_CASE("fast path: a set changed in place, or with no runs, still gives the readable result") {
