@@ -19,13 +19,18 @@ void Aerodynamics::add_forces(const Particles& /*p*/, const Matrix3X& x, const M
 
 // --- The fast path ---------------------------------------------------------------------------
 //
-// add_forces above is the lecture's loop. The fast path keeps its order, triangle by triangle,
-// but takes the triangles in chunks: the corners' positions and velocities of a chunk are
-// gathered into rows of their own, so that the compiler evaluates the exercise kernel (inlined
-// at link time) on four triangles at once; then the chunk's shares go to the corners one
-// triangle after the other, as add_forces adds them, so every particle sums the same numbers in
-// the same order. A thread takes the triangles with a corner in its range and adds to those
-// corners only.
+// add_forces above is the lecture's loop. The fast path evaluates the exercise kernel (inlined at
+// link time) on four triangles at once, and every particle still sums the same numbers in the
+// same order as there. The list is cut into groups (triangle_groups):
+//
+// - a run, such as a grid's row: its triangles alternate between phases whose corners move one
+//   particle per triangle, so the kernel reads them straight from the fast path's rows. The
+//   shares go out in one pass per (phase, corner), in the order in which a particle meets them
+//   in the list (the pass with the earlier list position for every particle first);
+// - other triangles: their corners are gathered 128 at a time into rows of their own, and their
+//   shares go to the corners one triangle after the other, as add_forces adds them.
+//
+// A thread takes the triangles with a corner in its range and adds to those corners only.
 
 namespace {
 
