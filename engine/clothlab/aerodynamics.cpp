@@ -36,31 +36,12 @@ namespace {
 
 constexpr Index kTriangleChunk = 128;  // triangles per chunk: 21 KiB of gathered inputs
 
-// share = aerodynamic_force(...) / 3 of triangles t = 0 .. count - 1, whose corners' positions
-// sit in rows 0-8 of `in` (x, y, z of corner 1, then of corners 2 and 3) and velocities in rows
-// 9-17, each row kTriangleChunk long; the shares go to rows 0-2 of `share`. Not inlined, so that
-// its pointers can be declared not to overlap: then the compiler vectorises the loop.
-[[gnu::noinline, gnu::flatten]] void aerodynamic_shares(Index count, const double* __restrict in,
-                                                        double* __restrict share, const Vec3 v_air,
-                                                        double rho, double cd) {
-  constexpr Index n = kTriangleChunk;
-  const auto corner = [&](int row, Index t) {
-    return Vec3(in[row * n + t], in[(row + 1) * n + t], in[(row + 2) * n + t]);
-  };
-  for (Index t = 0; t < count; ++t) {
-    const Vec3 f_aero = aerodynamic_force(corner(0, t), corner(3, t), corner(6, t), corner(9, t),
-                                          corner(12, t), corner(15, t), v_air, rho, cd);
-    const Vec3 s = f_aero / 3.0;  // each corner carries a third of the triangle
-    share[t] = s.x();
-    share[n + t] = s.y();
-    share[2 * n + t] = s.z();
-  }
-}
-
-// The same shares for triangles i = 0 .. count - 1 of a run: corner c's components at
-// xc[i], xc[nx + i], xc[2 nx + i] (velocities likewise, rows nv apart); shares to rows 0-2 of
-// `share`, kTriangleChunk apart.
-[[gnu::noinline, gnu::flatten]] void aerodynamic_shares_of_run(
+// share = aerodynamic_force(...) / 3 of triangles i = 0 .. count - 1, whose corner c has its
+// components at xc[i], xc[nx + i], xc[2 nx + i] and its velocity's at vc[i], vc[nv + i], ...;
+// the shares go to rows 0-2 of `share`, kTriangleChunk apart. A run's corners are read where
+// they are; gathered ones from rows kTriangleChunk long. Not inlined, so that its pointers can be
+// declared not to overlap what it writes: then the compiler vectorises the loop.
+[[gnu::noinline, gnu::flatten]] void aerodynamic_shares(
     Index count, Index nx, Index nv, const double* __restrict x1, const double* __restrict x2,
     const double* __restrict x3, const double* __restrict v1, const double* __restrict v2,
     const double* __restrict v3, double* __restrict share, const Vec3 v_air, double rho,
@@ -109,7 +90,9 @@ void Aerodynamics::add_triangles_soa(size_t k_begin, size_t k_end, const SoA3& x
       }
       ++count;
     }
-    aerodynamic_shares(count, in, share, v_air_, rho_, cd_);
+    // Rows of `in`: x, y, z of corners 1, 2, 3, then their velocities.
+    aerodynamic_shares(count, n, n, in, in + 3 * n, in + 6 * n, in + 9 * n, in + 12 * n,
+                       in + 15 * n, share, v_air_, rho_, cd_);
     for (Index q = 0; q < count; ++q) {
       for (Index corner : triangles_[chunk[q]]) {
         if (!in_range(corner)) continue;
@@ -201,10 +184,9 @@ void Aerodynamics::add_group_soa(const TriangleGroup& g, const SoA3& x, const So
     const Index i1 = std::min(i0 + n, i_end);
     for (int p = 0; p < g.period; ++p) {
       const Triangle& b = g.base[static_cast<size_t>(p)];
-      aerodynamic_shares_of_run(i1 - i0, x.cols(), v.cols(), x.data() + b[0] + i0,
-                                x.data() + b[1] + i0, x.data() + b[2] + i0, v.data() + b[0] + i0,
-                                v.data() + b[1] + i0, v.data() + b[2] + i0,
-                                share[static_cast<size_t>(p)], v_air_, rho_, cd_);
+      aerodynamic_shares(i1 - i0, x.cols(), v.cols(), x.data() + b[0] + i0, x.data() + b[1] + i0,
+                         x.data() + b[2] + i0, v.data() + b[0] + i0, v.data() + b[1] + i0,
+                         v.data() + b[2] + i0, share[static_cast<size_t>(p)], v_air_, rho_, cd_);
     }
     // Every particle takes its shares in the list's order: pass by pass (see triangle_groups).
     for (size_t k = 0; k < passes; ++k) {
