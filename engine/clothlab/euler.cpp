@@ -11,9 +11,9 @@ namespace {
 template <class Kernel>
 void euler_advance(World& world, double dt, Kernel kernel) {
   Particles& p = world.particles;
-  world.compute_forces(p.x, p.v, p.f);
-  // Each particle moves by its own force, so threads may share the loop (World::threads).
-  world.for_particles([&](Index begin, Index end) {
+  // Forces, then each particle moves by its own force: the loop may be split between threads,
+  // and on the fast path each thread moves its particles as soon as their forces are summed.
+  world.compute_forces_then(p.x, p.v, p.f, [&](Index begin, Index end) {
     for (Index i = begin; i < end; ++i) {
       const PointState next = kernel(p.x.col(i), p.v.col(i), p.f.col(i), p.inv_m[i], dt);
       p.x.col(i) = next.r;

@@ -1,5 +1,8 @@
 #include "clothlab/fast_forces.hpp"
 
+#include <algorithm>
+#include <atomic>
+
 #include "clothlab/threads.hpp"
 #include "clothlab/world.hpp"
 
@@ -52,18 +55,27 @@ bool prepare_fast_forces(const World& world, FastScratch& scratch) {
 }
 
 void fast_forces(const World& world, const Matrix3X& x, const Matrix3X& v, Matrix3X& f,
-                 FastScratch& scratch, ThreadTeam* team) {
+                 FastScratch& scratch, ThreadTeam* team,
+                 const std::function<void(Index begin, Index end)>* move, StepChecks* checks) {
   const auto& effects = world.force_effects;
   const Index n = x.cols();
   scratch.x.resize(3, padded(n, 21));
   scratch.v.resize(3, padded(n, 7));
   scratch.f.resize(3, padded(n, 49));
   f.resize(3, n);
+  std::atomic<bool> start_within = true;
   for_ranges(team, n, [&](Index begin, Index end) {
-    to_soa(begin, end, x.data(), scratch.x.data(), scratch.x.cols());
-    to_soa(begin, end, v.data(), scratch.v.data(), scratch.v.cols());
+    for (Index c0 = begin; c0 < end; c0 += kPassChunk) {
+      const Index c1 = std::min(c0 + kPassChunk, end);
+      to_soa(c0, c1, x.data(), scratch.x.data(), scratch.x.cols());
+      to_soa(c0, c1, v.data(), scratch.v.data(), scratch.v.cols());
+      if (checks && !world.guard.within(x, v, c0, c1)) start_within = false;
+    }
     scratch.f.middleCols(begin, end - begin).setZero();
   });
+  // The step's state was bad before it began: the guard names the particle and throws, before
+  // anything moves.
+  if (!start_within) world.guard.check(world, /*before_step=*/true);
   const auto move_f = [&](bool soa) {
     for_ranges(team, n, [&](Index begin, Index end) {
       if (soa) {
@@ -90,13 +102,32 @@ void fast_forces(const World& world, const Matrix3X& x, const Matrix3X& v, Matri
       ++last;
     if (!in_soa) move_f(true);
     in_soa = true;
+    const bool move_here = move && last == effects.size();
+    const bool check_end = move_here && checks && checks->end;
+    std::atomic<bool> end_within = true;
     for_ranges(team, n, [&](Index begin, Index end) {
       for (size_t k = e; k < last; ++k)
         effects[k]->add_forces_soa(world.particles, scratch.x, scratch.v, scratch.f, begin, end);
+      if (!move_here) return;
+      // These particles' forces are final: no other thread adds to them. The others read x and
+      // v from the copies, so moving these in x and v changes nothing they see.
+      const Particles& p = world.particles;
+      for (Index c0 = begin; c0 < end; c0 += kPassChunk) {
+        const Index c1 = std::min(c0 + kPassChunk, end);
+        from_soa(c0, c1, scratch.f.data(), scratch.f.cols(), f.data());
+        (*move)(c0, c1);
+        if (check_end && !world.guard.within(p.x, p.v, c0, c1)) end_within = false;
+      }
     });
+    if (check_end) {
+      checks->end_checked = true;
+      checks->end_within = end_within;
+    }
+    if (move_here) return;
     e = last;
   }
   if (in_soa) move_f(false);
+  if (move) for_ranges(team, n, *move);
 }
 
 }  // namespace clothlab

@@ -11,7 +11,8 @@
 //      the compiler computes four springs at once with vector instructions, through the same
 //      exercise kernels. With threads, each takes a contiguous range of particles and every
 //      effect adds the forces on that range only: no two threads write the same force;
-//   3. copy f back.
+//   3. copy f back. An integrator that moves each particle by its own force (the Euler
+//      methods) moves it right there, in the pass that summed its force (compute_forces_then).
 //
 // Each particle receives the same floating-point operations in the same order as on the readable
 // path, so the two agree bit for bit, with any number of threads (tests/engine/fast_path.cpp).
@@ -19,6 +20,7 @@
 // engine's layout, in its turn: f is copied across when the layout changes.
 #pragma once
 
+#include <functional>
 #include <vector>
 
 #include "clothlab/effect.hpp"
@@ -34,13 +36,34 @@ struct FastScratch {
   std::vector<char> soa;  // which force effects take the fast path, by their place in the world
 };
 
+// The guard's checks of a step (World::step) that a step's one pass takes on, when its
+// integrator moves every particle in that pass (Integrator::moves_in_one_pass): each particle is
+// checked while the pass has it in the cache, instead of in passes of their own over the state.
+struct StepChecks {
+  bool armed = false;        // World::step sets it; the step's compute_forces_then clears it
+  bool end = false;          // check the state after the move too (no post-step effect follows)
+  bool end_checked = false;  // the pass checked every particle after moving it,
+  bool end_within = false;   // and found them all within the guard's bounds
+};
+
 // Asks every force effect whether it has a fast path (once per evaluation, on one thread: an
 // effect may update its caches) and notes the answers in scratch. Whether any has one.
 bool prepare_fast_forces(const World& world, FastScratch& scratch);
 
 // Forces at (x, v) into f, as World::compute_forces_readable computes them, through the fast
-// path, after prepare_fast_forces. `team` may be null (one thread).
+// path, after prepare_fast_forces. `team` may be null (one thread). Then, if `move` is given,
+// move(begin, end) on ranges that cover every particle once (World::compute_forces_then): where
+// the last effect has a fast path, each thread calls it on its own particles, kPassChunk at a
+// time, right after copying their forces back, in the pass that summed them. With `checks`,
+// (x, v) is the state a step starts from: it is checked as it is copied (a bad one throws the
+// guard's error before any particle moves), and the new state as it is moved if checks->end.
 void fast_forces(const World& world, const Matrix3X& x, const Matrix3X& v, Matrix3X& f,
-                 FastScratch& scratch, ThreadTeam* team);
+                 FastScratch& scratch, ThreadTeam* team,
+                 const std::function<void(Index begin, Index end)>* move = nullptr,
+                 StepChecks* checks = nullptr);
+
+// Particles a thread copies, checks or moves at once: their x, v and f (36 KiB) stay in the
+// first-level and second-level caches from one to the next.
+inline constexpr Index kPassChunk = 512;
 
 }  // namespace clothlab

@@ -36,22 +36,26 @@ Index first_bad_column(const Matrix3X& a, double bound) {
 
 }  // namespace
 
+bool Guard::within(const Matrix3X& x, const Matrix3X& v, Index begin, Index end) const {
+  // Both tests always run: no branch between them, and the compiler vectorises each.
+  return all_within(x, begin, end, max_position) & all_within(v, begin, end, max_speed);
+}
+
 void Guard::check(const World& world, bool before_step) const {
   const Particles& p = world.particles;
   // Fast path: one vectorised pass over each array. |a| <= bound is false for a NaN (every
   // comparison with NaN is false), so this one test catches NaN, infinity and runaway values.
   // Only a failing state pays for the search that finds which particle went wrong.
   // Threads (World::threads) may share it, each checking a range of particles.
-  std::atomic<bool> x_ok = true, v_ok = true;
+  std::atomic<bool> ok = true;
   world.for_particles([&](Index begin, Index end) {
-    if (!all_within(p.x, begin, end, max_position)) x_ok = false;
-    if (!all_within(p.v, begin, end, max_speed)) v_ok = false;
+    if (!within(p.x, p.v, begin, end)) ok = false;
   });
-  if (x_ok && v_ok) return;
+  if (ok) return;
 
-  const bool position_bad = !x_ok;
-  const Index i =
-      position_bad ? first_bad_column(p.x, max_position) : first_bad_column(p.v, max_speed);
+  const Index bad_position = first_bad_column(p.x, max_position);
+  const bool position_bad = bad_position >= 0;
+  const Index i = position_bad ? bad_position : first_bad_column(p.v, max_speed);
   const Vec3 value = position_bad ? Vec3(p.x.col(i)) : Vec3(p.v.col(i));
   const char* quantity = position_bad ? "position" : "velocity";
   const char* unit = position_bad ? "m" : "m/s";

@@ -51,6 +51,11 @@ struct Guard {
   // be taken, before a NaN can spread from the particle that has it to its neighbours.
   void check(const World& world, bool before_step = false) const;
 
+  // The same test without the search and the error: whether every position in columns
+  // [begin, end) of x is within max_position and every velocity of v within max_speed (false
+  // for a NaN). A pass that already has those particles in the cache checks them with it.
+  bool within(const Matrix3X& x, const Matrix3X& v, Index begin, Index end) const;
+
   // Records the energy and the energy scale at the start of a run (World::step calls it
   // before the first step).
   void start(const World& world);

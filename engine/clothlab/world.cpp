@@ -2,6 +2,7 @@
 
 #include <cassert>
 #include <chrono>
+#include <utility>
 
 #include "clothlab/fast_forces.hpp"
 
@@ -17,19 +18,31 @@ double seconds_since(Clock::time_point start) {
 void World::step(double dt) {
   assert(integrator && "a world needs an integrator before it can step");
   if (steps == 0) guard.start(*this);
-  // The state the step starts from: the last step left it valid, but code between steps may
-  // have changed it. One vectorised pass; it names the particle before a NaN can spread.
-  guard.check(*this, /*before_step=*/true);
   if (!timing) {
+    // The state the step starts from: the last step left it valid, but code between steps may
+    // have changed it. The guard checks it (one vectorised pass) and names the particle before
+    // a NaN can spread. An integrator that moves every particle in one pass has that pass check
+    // each particle before anything moves, and after moving it when nothing else follows
+    // (StepChecks): the same checks, without two more passes over the whole state.
+    step_checks_ = StepChecks{};
+    if (integrator->moves_in_one_pass()) {
+      step_checks_.armed = true;
+      step_checks_.end = post_step_effects.empty();
+    } else {
+      guard.check(*this, /*before_step=*/true);
+    }
     integrator->advance(*this, dt);  // calls compute_forces (steps 1-2) as often as it needs
+    assert(!step_checks_.armed &&
+           "moves_in_one_pass, but advance did not call compute_forces_then");
     for (const auto& effect : post_step_effects)
       effect->apply(*this, dt);
     t += dt;
     ++steps;
-    guard.check(*this);
+    if (!(step_checks_.end_checked && step_checks_.end_within)) guard.check(*this);
     if (steps % guard.energy_check_every == 0) guard.check_energy(*this);
     return;
   }
+  guard.check(*this, /*before_step=*/true);
   // The same step, timed part by part (for --stats).
   timing->force_effects.resize(force_effects.size(), 0.0);
   timing->post_step_effects.resize(post_step_effects.size(), 0.0);
@@ -69,6 +82,23 @@ void World::compute_forces(const Matrix3X& x, const Matrix3X& v, Matrix3X& f) co
   ++force_evaluations;
   ++fast_evaluations;
   fast_forces(*this, x, v, f, fast_, team());
+}
+
+void World::compute_forces_then(const Matrix3X& x, const Matrix3X& v, Matrix3X& f,
+                                const std::function<void(Index begin, Index end)>& move) const {
+  // The step's own pass (World::step armed its checks): (x, v) is the state it starts from.
+  const bool step_pass = std::exchange(step_checks_.armed, false);
+  assert((!step_pass || (&x == &particles.x && &v == &particles.v)) &&
+         "compute_forces_then of a step moves the particles' own state");
+  if (!takes_fast_path() || !prepare_fast_forces(*this, fast_)) {
+    if (step_pass) guard.check(*this, /*before_step=*/true);
+    compute_forces_readable(x, v, f);
+    for_particles(move);
+    return;
+  }
+  ++force_evaluations;
+  ++fast_evaluations;
+  fast_forces(*this, x, v, f, fast_, team(), &move, step_pass ? &step_checks_ : nullptr);
 }
 
 void World::for_particles(const std::function<void(Index begin, Index end)>& range) const {

@@ -64,6 +64,14 @@ class World {
   // the effects; the two paths give the same f, bit for bit.
   void compute_forces(const Matrix3X& x, const Matrix3X& v, Matrix3X& f) const;
 
+  // compute_forces, then move(begin, end) on contiguous ranges of particles that cover them all
+  // once, as for_particles does: an integrator's update, which may read f and change the state
+  // of particles [begin, end) only. On the fast path each thread moves its own particles as soon
+  // as their forces are summed, a few hundred at a time, in the same pass over them: the forces
+  // are still in the cache, and the threads meet once instead of twice.
+  void compute_forces_then(const Matrix3X& x, const Matrix3X& v, Matrix3X& f,
+                           const std::function<void(Index begin, Index end)>& move) const;
+
   // The lecture's loop, the one the lessons show: clear f, then each effect adds its forces.
   void compute_forces_readable(const Matrix3X& x, const Matrix3X& v, Matrix3X& f) const;
 
@@ -86,6 +94,7 @@ class World {
 
   mutable std::unique_ptr<ThreadTeam> team_;
   mutable FastScratch fast_;
+  mutable StepChecks step_checks_;  // what the current step's one pass checks (World::step)
 };
 
 }  // namespace clothlab

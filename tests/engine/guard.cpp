@@ -5,6 +5,7 @@
 #include <string>
 
 #include "clothlab/gravity.hpp"
+#include "clothlab/scene.hpp"
 #include "test_util.hpp"
 
 using clothlab::Vec3;
@@ -86,4 +87,111 @@ TEST_CASE("guard: a calm run is never stopped") {
   for (int s = 0; s < 1000; ++s)
     world.step(0.001);
   CHECK(world.steps == 1000);
+}
+
+namespace {
+
+// A hanging cloth, 24 x 20, springs and gravity: every force effect has a fast path, so with
+// the Euler methods a step is one pass that also checks the state (World::step, StepChecks).
+// `extra` adds tables; `ks` and `dt` set how stable it is.
+clothlab::Scene hanging_cloth(const std::string& method, double ks, double dt,
+                              const std::string& extra = "") {
+  const std::string text = R"([cloth]
+rows = 24
+cols = 20
+spacing = 0.02
+mass = 0.5
+pins = "top-corners"
+[springs]
+ks = )" + std::to_string(ks) +
+                           R"(
+kd = 0.01
+[gravity]
+[integrator]
+method = ")" + method + R"("
+dt = )" + std::to_string(dt) +
+                           R"(
+duration = 10.0
+)" + extra;
+  return clothlab::parse_scene(text, "guard.toml");
+}
+
+// How a run of up to `steps` steps ended: the error's step, particle and text, or step -1.
+struct Stop {
+  long step = -1;
+  clothlab::Index particle = -1;
+  std::string what;
+};
+
+Stop run_until_stopped(clothlab::Scene& scene, int steps) {
+  try {
+    for (int s = 0; s < steps; ++s)
+      scene.world.step(scene.dt);
+  } catch (const clothlab::SimulationError& e) {
+    return {e.step(), e.particle(), e.what()};
+  }
+  return {};
+}
+
+}  // namespace
+
+TEST_CASE("guard: a state spoiled between steps stops the next step before anything moves") {
+  // Every way the check can run: in the Euler methods' one pass (fast path, 1 and 2 threads),
+  // on the readable path, and on its own before an integrator of several passes.
+  struct Setting {
+    const char* method;
+    bool fast;
+    int threads;
+  };
+  for (const Setting& s :
+       {Setting{"symplectic-euler", true, 1}, Setting{"symplectic-euler", true, 2},
+        Setting{"explicit-euler", false, 1}, Setting{"rk4", true, 2}}) {
+    CAPTURE(s.method);
+    CAPTURE(s.fast);
+    CAPTURE(s.threads);
+    clothlab::Scene scene = hanging_cloth(s.method, 50.0, 0.001);
+    clothlab::World& world = scene.world;
+    world.fast_path = s.fast;
+    world.threads = s.threads;
+    for (int k = 0; k < 10; ++k)
+      world.step(scene.dt);
+    // Code between steps puts a NaN into one particle's velocity.
+    world.particles.v(2, 301) = std::numeric_limits<double>::quiet_NaN();
+    const clothlab::Matrix3X x_before = world.particles.x;
+    const Stop stop = run_until_stopped(scene, 1);
+    CAPTURE(stop.what);
+    CHECK(stop.step == 11);
+    CHECK(stop.particle == 301);
+    CHECK(stop.what.find("blew up before step 11") != std::string::npos);
+    CHECK(stop.what.find("velocity is not finite") != std::string::npos);
+    // Nothing moved, and the step was not counted.
+    CHECK((world.particles.x.array() == x_before.array()).all());
+    CHECK(world.steps == 10);
+  }
+}
+
+TEST_CASE("guard: a blow-up stops the fast path's one pass as it stops the readable path") {
+  // Far too stiff for dt: the cloth blows up within a few dozen steps. The fast path checks the
+  // state in its one pass (1 and 2 threads), or after a post-step effect ([ground]) on its own;
+  // either way the run must stop at the same step, at the same particle, with the same words.
+  for (const std::string extra : {"", "[ground]\ny = -5.0\n"}) {
+    for (const char* method : {"symplectic-euler", "explicit-euler"}) {
+      CAPTURE(extra);
+      CAPTURE(method);
+      clothlab::Scene readable = hanging_cloth(method, 4e5, 0.002, extra);
+      readable.world.fast_path = false;
+      const Stop expected = run_until_stopped(readable, 2000);
+      REQUIRE(expected.step > 0);
+      for (int threads : {1, 2}) {
+        CAPTURE(threads);
+        clothlab::Scene fast = hanging_cloth(method, 4e5, 0.002, extra);
+        fast.world.threads = threads;
+        const Stop stop = run_until_stopped(fast, 2000);
+        CHECK(fast.world.fast_evaluations > 0);
+        CHECK(stop.step == expected.step);
+        CHECK(stop.particle == expected.particle);
+        CHECK(stop.what == expected.what);
+      }
+    }
+  }
 }
