@@ -97,6 +97,55 @@ std::string show(const Matrix3X& m) {
   return out.str();
 }
 
+// The positions x [m] and velocities v [m/s] of particles, one column per particle.
+struct State {
+  Matrix3X x, v;
+};
+
+// The state (x, v) after one step of dt [s] under accel, taken with fresh stages.
+State after_one_step(Step step, Matrix3X x, Matrix3X v, double dt, const AccelerationField& accel) {
+  RungeKuttaStages stages = fresh_stages(x.cols());
+  step(x, v, dt, accel, stages);
+  return {x, v};
+}
+
+// One step of dt [s] with every call of accel recorded, for the cases that check where a step
+// asks for its accelerations. Two particles under a = -4 x - 0.5 v + (0, -9.8, 0): the
+// acceleration depends on both x and v, so a trial state with the wrong position or the wrong
+// velocity shows. Gives the start state (x0, v0), the state the step ended at (x, v) and the
+// calls in order.
+struct RecordedStep {
+  Matrix3X x0, v0, x, v;
+  std::vector<Call> calls;
+};
+
+RecordedStep record_one_step(Step step, double dt) {
+  const Vec3 g(0.0, -9.8, 0.0);
+  const AccelerationField field = [g](const Matrix3X& xs, const Matrix3X& vs, Matrix3X& a) {
+    a = -4.0 * xs - 0.5 * vs;
+    a.colwise() += g;
+  };
+  RecordedStep r;
+  r.x0 = columns({Vec3(0.3, -1.2, 2.0), Vec3(-0.7, 0.4, 1.1)});
+  r.v0 = columns({Vec3(1.5, -0.2, 0.9), Vec3(-0.4, 2.2, 0.1)});
+  r.x = r.x0;
+  r.v = r.v0;
+  RungeKuttaStages stages = fresh_stages(2);
+  step(r.x, r.v, dt, recording(field, r.x, r.v, r.calls), stages);
+  return r;
+}
+
+// Three particles, each under its own acceleration: 0 on the spring a = -4 x, 1 pinned (inverse
+// mass 0, so a = 0) and 2 under the drag a = -2 v.
+AccelerationField spring_pinned_and_drag() {
+  return [](const Matrix3X& xs, const Matrix3X& vs, Matrix3X& a) {
+    a.resize(3, xs.cols());
+    a.col(0) = -4.0 * xs.col(0);
+    a.col(1).setZero();
+    a.col(2) = -2.0 * vs.col(2);
+  };
+}
+
 // The energy per unit mass of each particle on a spring to the origin,
 // E_k = (|v_k|^2 + w_k^2 |x_k|^2) / 2 [J/kg].
 std::vector<double> spring_energies(const Matrix3X& x, const Matrix3X& v,
@@ -107,6 +156,24 @@ std::vector<double> spring_energies(const Matrix3X& x, const Matrix3X& v,
     e.push_back(0.5 * (v.col(k).squaredNorm() + wk * wk * x.col(k).squaredNorm()));
   }
   return e;
+}
+
+// The energies (spring_energies) of three particles before and after one step of dt [s], each
+// on its own spring to the origin, a_k = -w_k^2 x_k, from a state with no zero component.
+struct EnergyChange {
+  std::vector<double> before, after;
+};
+
+EnergyChange spring_energies_over_one_step(Step step, const std::vector<double>& w, double dt) {
+  const AccelerationField field = [&w](const Matrix3X& xs, const Matrix3X&, Matrix3X& a) {
+    a.resize(3, xs.cols());
+    for (Index k = 0; k < xs.cols(); ++k)
+      a.col(k) = -w[static_cast<size_t>(k)] * w[static_cast<size_t>(k)] * xs.col(k);
+  };
+  const Matrix3X x = columns({Vec3(0.3, -1.2, 2.0), Vec3(-0.7, 0.4, 1.1), Vec3(1.0, 0.5, -0.25)});
+  const Matrix3X v = columns({Vec3(1.5, -0.2, 0.9), Vec3(-0.4, 2.2, 0.1), Vec3(0.0, -3.0, 0.5)});
+  const State end = after_one_step(step, x, v, dt, field);
+  return {spring_energies(x, v, w), spring_energies(end.x, end.v, w)};
 }
 
 // The error after one period of a spring with w = 2 pi 1/s (period 1 s), started at x = 1 m at
@@ -171,10 +238,8 @@ TEST_SUITE("ex07") {
     //   x' = x + dt v2 = 1 + 0.03 = 1.03,          v' = v + dt a2 = 0.5 - 0.41 = 0.09
     // Symbolically, with y = w dt: x' = x (1 - y^2/2) + dt v, v' = v (1 - y^2/2) - w^2 dt x,
     // the exact solution's Taylor polynomial to second order.
-    Matrix3X x = columns({Vec3(1.0, 0.0, 0.0)});
-    Matrix3X v = columns({Vec3(0.5, 0.0, 0.0)});
-    RungeKuttaStages stages = fresh_stages(1);
-    clothlab::midpoint_step(x, v, 0.1, spring(4.0), stages);
+    const auto [x, v] = after_one_step(clothlab::midpoint_step, columns({Vec3(1.0, 0.0, 0.0)}),
+                                       columns({Vec3(0.5, 0.0, 0.0)}), 0.1, spring(4.0));
     INFO(
         "spring a = -4 x, dt = 0.1 s, from x = 1 m, v = 0.5 m/s: the midpoint step gives "
         "x' = x + dt v2 = 1.03 m and v' = v + dt a2 = 0.09 m/s, with v2 = 0.3 m/s and a2 = -4.1 "
@@ -195,18 +260,8 @@ TEST_SUITE("ex07") {
     //   call 2 at (x + dt/2 v, v + dt/2 a1), which returns a2,
     // and then x' = x + dt v2, v' = v + dt a2 with v2 the velocity of call 2. Each is checked
     // against what the step itself passed and got back, so one wrong line fails one check.
-    const Vec3 g(0.0, -9.8, 0.0);
-    const AccelerationField field = [g](const Matrix3X& xs, const Matrix3X& vs, Matrix3X& a) {
-      a = -4.0 * xs - 0.5 * vs;
-      a.colwise() += g;
-    };
     const double dt = 0.05;
-    const Matrix3X x0 = columns({Vec3(0.3, -1.2, 2.0), Vec3(-0.7, 0.4, 1.1)});
-    const Matrix3X v0 = columns({Vec3(1.5, -0.2, 0.9), Vec3(-0.4, 2.2, 0.1)});
-    Matrix3X x = x0, v = v0;
-    std::vector<Call> calls;
-    RungeKuttaStages stages = fresh_stages(2);
-    clothlab::midpoint_step(x, v, dt, recording(field, x, v, calls), stages);
+    const auto [x0, v0, x, v, calls] = record_one_step(clothlab::midpoint_step, dt);
     {
       INFO(
           "midpoint_step must call accel exactly twice per step, once at the start and once at "
@@ -253,10 +308,8 @@ TEST_SUITE("ex07") {
     //        (e^(-z) = 1 - z + z^2/2 - ..., cut after z^2: second order)
     //   x' = x + dt v2 = x + 0.1 * 0.9 v = x + 0.09 v
     // From x = (1, 2, 3) m, v = (1, -2, 3) m/s: v' = (0.82, -1.64, 2.46), x' = (1.09, 1.82, 3.27).
-    Matrix3X x = columns({Vec3(1.0, 2.0, 3.0)});
-    Matrix3X v = columns({Vec3(1.0, -2.0, 3.0)});
-    RungeKuttaStages stages = fresh_stages(1);
-    clothlab::midpoint_step(x, v, 0.1, drag(2.0), stages);
+    const auto [x, v] = after_one_step(clothlab::midpoint_step, columns({Vec3(1.0, 2.0, 3.0)}),
+                                       columns({Vec3(1.0, -2.0, 3.0)}), 0.1, drag(2.0));
     INFO(
         "drag a = -2 v, dt = 0.1 s: the midpoint step scales v by 1 - z + z^2/2 = 0.82 (z = "
         "c dt = 0.2, the Taylor polynomial of e^(-z)) and moves x by dt v2 = 0.09 v. v' = 0.8 v "
@@ -271,10 +324,9 @@ TEST_SUITE("ex07") {
     //   x' = x + dt v2 = x + v dt + g dt^2/2,   v' = v + g dt:
     // the exact parabola, whatever dt. g = (0, -9.8, 0), dt = 0.5 s, x = (0, 10, 0) m,
     // v = (2, 0, -1) m/s: x' = (1, 10 - 9.8 * 0.125, -0.5) = (1, 8.775, -0.5), v' = (2, -4.9, -1).
-    Matrix3X x = columns({Vec3(0.0, 10.0, 0.0)});
-    Matrix3X v = columns({Vec3(2.0, 0.0, -1.0)});
-    RungeKuttaStages stages = fresh_stages(1);
-    clothlab::midpoint_step(x, v, 0.5, constant(Vec3(0.0, -9.8, 0.0)), stages);
+    const auto [x, v] =
+        after_one_step(clothlab::midpoint_step, columns({Vec3(0.0, 10.0, 0.0)}),
+                       columns({Vec3(2.0, 0.0, -1.0)}), 0.5, constant(Vec3(0.0, -9.8, 0.0)));
     INFO(
         "under constant gravity the midpoint method is exact: x' = x + v dt + g dt^2/2 = "
         "(1, 8.775, -0.5) m after 0.5 s. y = 10 m means x moved with the start velocity v "
@@ -294,17 +346,7 @@ TEST_SUITE("ex07") {
     // y = 0.5, 1, 2 give 65/64, 5/4 and 5. (Euler would give 1 + y^2 = 1.25, 2, 5.)
     const std::vector<double> w = {1.0, 2.0, 4.0};
     const std::vector<double> factor = {65.0 / 64.0, 5.0 / 4.0, 5.0};
-    const AccelerationField field = [&w](const Matrix3X& xs, const Matrix3X&, Matrix3X& a) {
-      a.resize(3, xs.cols());
-      for (Index k = 0; k < xs.cols(); ++k)
-        a.col(k) = -w[static_cast<size_t>(k)] * w[static_cast<size_t>(k)] * xs.col(k);
-    };
-    Matrix3X x = columns({Vec3(0.3, -1.2, 2.0), Vec3(-0.7, 0.4, 1.1), Vec3(1.0, 0.5, -0.25)});
-    Matrix3X v = columns({Vec3(1.5, -0.2, 0.9), Vec3(-0.4, 2.2, 0.1), Vec3(0.0, -3.0, 0.5)});
-    const std::vector<double> e0 = spring_energies(x, v, w);
-    RungeKuttaStages stages = fresh_stages(3);
-    clothlab::midpoint_step(x, v, 0.5, field, stages);
-    const std::vector<double> e1 = spring_energies(x, v, w);
+    const auto [e0, e1] = spring_energies_over_one_step(clothlab::midpoint_step, w, 0.5);
     for (size_t k = 0; k < w.size(); ++k) {
       const double y = w[k] * 0.5;
       CAPTURE(y);
@@ -344,16 +386,11 @@ TEST_SUITE("ex07") {
     //   1: pinned (inverse mass 0, so a = 0) and at rest at (5, 5, 5): x' = x, v' = 0;
     //   2: the drag a = -2 v from x = (1, 2, 3), v = (1, -2, 3): as above, x' = x + 0.09 v =
     //      (1.09, 1.82, 3.27), v' = 0.82 v = (0.82, -1.64, 2.46).
-    const AccelerationField field = [](const Matrix3X& xs, const Matrix3X& vs, Matrix3X& a) {
-      a.resize(3, xs.cols());
-      a.col(0) = -4.0 * xs.col(0);
-      a.col(1).setZero();
-      a.col(2) = -2.0 * vs.col(2);
-    };
-    Matrix3X x = columns({Vec3(1.0, 0.0, 0.0), Vec3(5.0, 5.0, 5.0), Vec3(1.0, 2.0, 3.0)});
-    Matrix3X v = columns({Vec3(0.5, 0.0, 0.0), Vec3::Zero(), Vec3(1.0, -2.0, 3.0)});
-    RungeKuttaStages stages = fresh_stages(3);
-    clothlab::midpoint_step(x, v, 0.1, field, stages);
+    const auto [x, v] =
+        after_one_step(clothlab::midpoint_step,
+                       columns({Vec3(1.0, 0.0, 0.0), Vec3(5.0, 5.0, 5.0), Vec3(1.0, 2.0, 3.0)}),
+                       columns({Vec3(0.5, 0.0, 0.0), Vec3::Zero(), Vec3(1.0, -2.0, 3.0)}), 0.1,
+                       spring_pinned_and_drag());
     INFO(
         "every column of x and v is one particle and moves only by its own acceleration: step "
         "whole matrices (x + 0.5 * dt * v), not just the first column (see "
@@ -387,10 +424,8 @@ TEST_SUITE("ex07") {
     //   v' = 0.5 + 0.1/6 (-4 - 8.2 - 8.12 - 4.118) = 0.5 - 2.4438/6 = 0.0927
     // Symbolically, with y = w dt = 0.2: x' = x (1 - y^2/2 + y^4/24) + dt v (1 - y^2/6), the
     // Taylor polynomial of the exact x(t) = cos(2t) + 0.25 sin(2t) = 1.029734 to fourth order.
-    Matrix3X x = columns({Vec3(1.0, 0.0, 0.0)});
-    Matrix3X v = columns({Vec3(0.5, 0.0, 0.0)});
-    RungeKuttaStages stages = fresh_stages(1);
-    clothlab::rk4_step(x, v, 0.1, spring(4.0), stages);
+    const auto [x, v] = after_one_step(clothlab::rk4_step, columns({Vec3(1.0, 0.0, 0.0)}),
+                                       columns({Vec3(0.5, 0.0, 0.0)}), 0.1, spring(4.0));
     INFO(
         "spring a = -4 x, dt = 0.1 s, from x = 1 m, v = 0.5 m/s: the RK4 step gives "
         "x' = 1.0297333 m and v' = 0.0927 m/s (stage velocities 0.5, 0.3, 0.295, 0.094 and "
@@ -412,18 +447,8 @@ TEST_SUITE("ex07") {
     // and then x' = x + dt/6 (v1 + 2 v2 + 2 v3 + v4), v' = v + dt/6 (a1 + 2 a2 + 2 a3 + a4),
     // with vk the velocity of call k. Each is checked against what the step itself passed and
     // got back, so one wrong line fails one check.
-    const Vec3 g(0.0, -9.8, 0.0);
-    const AccelerationField field = [g](const Matrix3X& xs, const Matrix3X& vs, Matrix3X& a) {
-      a = -4.0 * xs - 0.5 * vs;
-      a.colwise() += g;
-    };
     const double dt = 0.05;
-    const Matrix3X x0 = columns({Vec3(0.3, -1.2, 2.0), Vec3(-0.7, 0.4, 1.1)});
-    const Matrix3X v0 = columns({Vec3(1.5, -0.2, 0.9), Vec3(-0.4, 2.2, 0.1)});
-    Matrix3X x = x0, v = v0;
-    std::vector<Call> calls;
-    RungeKuttaStages stages = fresh_stages(2);
-    clothlab::rk4_step(x, v, dt, recording(field, x, v, calls), stages);
+    const auto [x0, v0, x, v, calls] = record_one_step(clothlab::rk4_step, dt);
     {
       INFO("rk4_step must call accel exactly four times per step, once per stage; it was called ",
            calls.size(), " times (see lessons/07-integrators/README.md)");
@@ -483,10 +508,8 @@ TEST_SUITE("ex07") {
     //        = x + 0.1 v * 2719/3000 = x + (2719/30000) v
     // From x = (1, 2, 3) m and v = (1, -2, 3) m/s.
     const Vec3 x0(1.0, 2.0, 3.0), v0(1.0, -2.0, 3.0);
-    Matrix3X x = columns({x0});
-    Matrix3X v = columns({v0});
-    RungeKuttaStages stages = fresh_stages(1);
-    clothlab::rk4_step(x, v, 0.1, drag(2.0), stages);
+    const auto [x, v] =
+        after_one_step(clothlab::rk4_step, columns({x0}), columns({v0}), 0.1, drag(2.0));
     INFO(
         "drag a = -2 v, dt = 0.1 s: the RK4 step scales v by 1 - z + z^2/2 - z^3/6 + z^4/24 = "
         "0.8187333 (z = c dt = 0.2, the Taylor polynomial of e^(-z)) and moves x by "
@@ -502,10 +525,9 @@ TEST_SUITE("ex07") {
     //   x' = x + dt/6 (6 v + 2 dt g + dt g) = x + v dt + g dt^2/2,   v' = v + g dt:
     // the exact parabola. Same numbers as ex07.1: g = (0, -9.8, 0), dt = 0.5 s,
     // x = (0, 10, 0) m, v = (2, 0, -1) m/s give x' = (1, 8.775, -0.5), v' = (2, -4.9, -1).
-    Matrix3X x = columns({Vec3(0.0, 10.0, 0.0)});
-    Matrix3X v = columns({Vec3(2.0, 0.0, -1.0)});
-    RungeKuttaStages stages = fresh_stages(1);
-    clothlab::rk4_step(x, v, 0.5, constant(Vec3(0.0, -9.8, 0.0)), stages);
+    const auto [x, v] =
+        after_one_step(clothlab::rk4_step, columns({Vec3(0.0, 10.0, 0.0)}),
+                       columns({Vec3(2.0, 0.0, -1.0)}), 0.5, constant(Vec3(0.0, -9.8, 0.0)));
     INFO(
         "under constant gravity RK4 is exact: x' = x + v dt + g dt^2/2 = (1, 8.775, -0.5) m "
         "after 0.5 s; x' averages the stage velocities v1..v4 with weights (1, 2, 2, 1)/6 "
@@ -524,17 +546,7 @@ TEST_SUITE("ex07") {
     // 147425/147456, 569/576 and 5/9: RK4 loses a little energy each step, the more the larger dt.
     const std::vector<double> w = {1.0, 2.0, 4.0};
     const std::vector<double> factor = {147425.0 / 147456.0, 569.0 / 576.0, 5.0 / 9.0};
-    const AccelerationField field = [&w](const Matrix3X& xs, const Matrix3X&, Matrix3X& a) {
-      a.resize(3, xs.cols());
-      for (Index k = 0; k < xs.cols(); ++k)
-        a.col(k) = -w[static_cast<size_t>(k)] * w[static_cast<size_t>(k)] * xs.col(k);
-    };
-    Matrix3X x = columns({Vec3(0.3, -1.2, 2.0), Vec3(-0.7, 0.4, 1.1), Vec3(1.0, 0.5, -0.25)});
-    Matrix3X v = columns({Vec3(1.5, -0.2, 0.9), Vec3(-0.4, 2.2, 0.1), Vec3(0.0, -3.0, 0.5)});
-    const std::vector<double> e0 = spring_energies(x, v, w);
-    RungeKuttaStages stages = fresh_stages(3);
-    clothlab::rk4_step(x, v, 0.5, field, stages);
-    const std::vector<double> e1 = spring_energies(x, v, w);
+    const auto [e0, e1] = spring_energies_over_one_step(clothlab::rk4_step, w, 0.5);
     for (size_t k = 0; k < w.size(); ++k) {
       const double y = w[k] * 0.5;
       CAPTURE(y);
@@ -573,17 +585,10 @@ TEST_SUITE("ex07") {
     //   1: pinned (inverse mass 0, so a = 0) and at rest at (5, 5, 5): x' = x, v' = 0;
     //   2: the drag a = -2 v from x = (1, 2, 3), v = (1, -2, 3): as above,
     //      x' = x + (2719/30000) v, v' = (12281/15000) v.
-    const AccelerationField field = [](const Matrix3X& xs, const Matrix3X& vs, Matrix3X& a) {
-      a.resize(3, xs.cols());
-      a.col(0) = -4.0 * xs.col(0);
-      a.col(1).setZero();
-      a.col(2) = -2.0 * vs.col(2);
-    };
     const Vec3 x2(1.0, 2.0, 3.0), v2(1.0, -2.0, 3.0);
-    Matrix3X x = columns({Vec3(1.0, 0.0, 0.0), Vec3(5.0, 5.0, 5.0), x2});
-    Matrix3X v = columns({Vec3(0.5, 0.0, 0.0), Vec3::Zero(), v2});
-    RungeKuttaStages stages = fresh_stages(3);
-    clothlab::rk4_step(x, v, 0.1, field, stages);
+    const auto [x, v] = after_one_step(
+        clothlab::rk4_step, columns({Vec3(1.0, 0.0, 0.0), Vec3(5.0, 5.0, 5.0), x2}),
+        columns({Vec3(0.5, 0.0, 0.0), Vec3::Zero(), v2}), 0.1, spring_pinned_and_drag());
     INFO(
         "every column of x and v is one particle and moves only by its own acceleration: step "
         "whole matrices, not just the first column (see lessons/07-integrators/README.md)");
