@@ -20,6 +20,7 @@
 #include "clothlab/spring_damper.hpp"
 #include "clothlab/stability.hpp"
 #include "clothlab/world.hpp"
+#include "test_util.hpp"
 
 using clothlab::Index;
 using clothlab::Vec3;
@@ -27,22 +28,11 @@ using clothlab::World;
 
 namespace {
 
-const std::vector<std::string> kMethods = {
-    "explicit-euler",  "symplectic-euler", "midpoint",      "rk4",
-    "velocity-verlet", "position-verlet",  "implicit-euler"};
-
 // A unit mass on a spring (ks = w^2, kd = beta, rest length 1 m) to a pinned anchor at the
 // origin, displaced by x along the spring with velocity v: exactly the oscillator
 // x'' = -w^2 x - beta x' while it stays on the positive x axis.
 World oscillator(const std::string& method, double omega, double beta, double x, double v) {
-  World world;
-  world.particles.add(Vec3::Zero(), Vec3::Zero(), 1.0);
-  world.particles.inv_m[0] = 0.0;
-  world.particles.add(Vec3(1.0 + x, 0.0, 0.0), Vec3(v, 0.0, 0.0), 1.0);
-  clothlab::SpringSet spring;
-  spring.add(0, 1, omega * omega, beta, 1.0, world.particles.x);
-  world.force_effects.push_back(
-      std::make_unique<clothlab::SpringDampers>("springs", std::move(spring)));
+  World world = test::anchored_spring(1.0, omega * omega, beta, x, v);
   world.integrator = clothlab::make_integrator(method);
   if (auto* implicit = dynamic_cast<clothlab::ImplicitEuler*>(world.integrator.get()))
     implicit->tolerance = 1e-15;
@@ -57,7 +47,7 @@ double displacement(const World& world) {
 
 TEST_CASE("advisor: each step matrix is the engine's integrator, step for step") {
   const double omega = 7.0, beta = 1.3, dt = 0.05;
-  for (const std::string& method : kMethods) {
+  for (const std::string& method : test::all_integrators()) {
     CAPTURE(method);
     World world = oscillator(method, omega, beta, 0.2, -0.7);
     const Eigen::MatrixXd a = clothlab::oscillator_step_matrix(method, dt, omega, beta);
@@ -293,8 +283,7 @@ dt = 0.001
 duration = 4.0
 )",
                                                 "<flag>");
-  for (long s = 0; s < scene.step_count(); ++s)
-    scene.world.step(scene.dt);
+  test::run_to_end(scene);
   CHECK(scene.world.guard.energy_scale() > 0.0);
 }
 

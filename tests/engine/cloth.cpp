@@ -11,6 +11,7 @@
 #include "clothlab/gravity.hpp"
 #include "clothlab/scene.hpp"
 #include "clothlab/spring_damper.hpp"
+#include "test_util.hpp"
 
 using clothlab::Index;
 using clothlab::Vec3;
@@ -41,13 +42,6 @@ dt = 0.0005
 duration = 1
 )";
 
-const clothlab::SpringDampers* find_springs(const clothlab::World& world, std::string_view name) {
-  for (const auto& e : world.force_effects) {
-    if (e->name() == name) return dynamic_cast<const clothlab::SpringDampers*>(e.get());
-  }
-  return nullptr;
-}
-
 // Sets every velocity to a fixed pseudo-random kick (the same on every run) [m/s].
 void kick(clothlab::World& world) {
   unsigned state = 12345u;
@@ -67,15 +61,13 @@ TEST_CASE("cloth: a grid has the spring counts the lecture's pictures give") {
   // rows x cols particles: structural r(c-1) + c(r-1), shear 2(r-1)(c-1),
   // bending r(c-2) + c(r-2). For 12 x 12: 264, 242 and 240.
   clothlab::Scene scene = clothlab::parse_scene(kHangingCloth, "hanging.toml");
-  const auto* springs = find_springs(scene.world, "springs");
-  const auto* bending = find_springs(scene.world, "bending");
-  REQUIRE(springs != nullptr);
-  REQUIRE(bending != nullptr);
-  CHECK(springs->springs().size() == 264 + 242);
-  CHECK(bending->springs().size() == 240);
+  const clothlab::SpringSet& springs = test::springs_of(scene.world, "springs");
+  const clothlab::SpringSet& bending = test::springs_of(scene.world, "bending");
+  CHECK(springs.size() == 264 + 242);
+  CHECK(bending.size() == 240);
   CHECK(scene.world.triangles.size() == 2 * 11 * 11);
   // Rest lengths are the build-time distances: 4 cm, 4 cm * sqrt(2) and 8 cm.
-  for (double l0 : bending->springs().l0)
+  for (double l0 : bending.l0)
     CHECK(l0 == doctest::Approx(0.08));
 }
 
@@ -103,8 +95,7 @@ TEST_CASE("cloth: internal forces conserve momentum for every integrator") {
 TEST_CASE("cloth: pinned particles stay bitwise fixed") {
   clothlab::Scene scene = clothlab::parse_scene(kHangingCloth, "hanging.toml");
   const clothlab::Matrix3X x0 = scene.world.particles.x;
-  for (long s = 0; s < scene.step_count(); ++s)
-    scene.world.step(scene.dt);
+  test::run_to_end(scene);
   const Index top_right = 11;
   for (Index i : {Index{0}, top_right}) {
     CAPTURE(i);
@@ -163,8 +154,7 @@ dt = 0.001
 duration = 0.1
 )",
                                                 "coincident.toml");
-  for (long s = 0; s < scene.step_count(); ++s)
-    scene.world.step(scene.dt);
+  test::run_to_end(scene);
   CHECK(scene.world.particles.x.allFinite());
 }
 

@@ -5,6 +5,7 @@
 
 #include "clothlab/ground_collision.hpp"
 #include "clothlab/scene.hpp"
+#include "test_util.hpp"
 
 using clothlab::Index;
 using clothlab::Vec3;
@@ -73,8 +74,7 @@ TEST_CASE("collision: a slide stops after v0^2 / (2 mu_d g)") {
   // continuous deceleration mu_d g. v0 = 4 m/s, mu_d = 0.4: d = 16 / (2 * 0.4 * 9.8) = 2.0408 m.
   clothlab::Scene scene =
       one_particle("[0, 0, 0]", "[4, 0, 0]", "mu_s = 0.5\nmu_d = 0.4\n", 0.0005, 2.0);
-  for (long s = 0; s < scene.step_count(); ++s)
-    scene.world.step(scene.dt);
+  test::run_to_end(scene);
   CHECK(scene.world.particles.v.col(0).isZero(0.0));
   CHECK(scene.world.particles.x(0, 0) == doctest::Approx(16.0 / (2 * 0.4 * 9.8)).epsilon(0.005));
 }

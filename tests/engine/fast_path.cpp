@@ -21,6 +21,7 @@
 #include "clothlab/scene.hpp"
 #include "clothlab/spring_damper.hpp"
 #include "clothlab/threads.hpp"
+#include "test_util.hpp"
 
 using clothlab::Index;
 using clothlab::Matrix3X;
@@ -299,11 +300,7 @@ TEST_CASE("fast path: a grid's triangles form one run per row, two triangles a c
   const Index rows = 5, cols = 12;  // runs of 11 cells: long enough to be worth one
   const clothlab::Scene scene =
       clothlab::parse_scene(cloth("", "symplectic-euler", rows, cols), "t");
-  const clothlab::Aerodynamics* aero = nullptr;
-  for (const auto& effect : scene.world.force_effects) {
-    if (effect->name() == "aerodynamics")
-      aero = dynamic_cast<const clothlab::Aerodynamics*>(effect.get());
-  }
+  const auto* aero = test::find_force_effect<clothlab::Aerodynamics>(scene.world);
   REQUIRE(aero != nullptr);
   const auto groups = clothlab::Aerodynamics::triangle_groups(aero->triangles());
   REQUIRE(groups.size() == rows - 1);

@@ -40,15 +40,10 @@ using clothlab::Vec3;
 
 namespace {
 
-// Every integrator a scene may name.
-std::vector<std::string> all_integrators() {
-  return {clothlab::integrator_names().begin(), clothlab::integrator_names().end()};
-}
-
 // Every integrator with every thread count of `threads`: (method, threads) pairs.
 std::vector<std::pair<std::string, int>> each_integrator_with(std::initializer_list<int> threads) {
   std::vector<std::pair<std::string, int>> pairs;
-  for (const std::string& method : all_integrators()) {
+  for (const std::string& method : test::all_integrators()) {
     for (int t : threads)
       pairs.emplace_back(method, t);
   }
@@ -104,23 +99,8 @@ double w_max_bound(const clothlab::World& world) {
   return std::sqrt(spring_bound(world, &clothlab::SpringSet::ks));
 }
 
-clothlab::SpringSet& springs_of(clothlab::World& world) {
-  clothlab::SpringDampers* springs = clothlab::find_spring_effect(world, "springs");
-  REQUIRE(springs != nullptr);
-  return springs->springs();
-}
-
-std::set<std::pair<Index, Index>> ends_of(const clothlab::SpringSet& s) {
-  std::set<std::pair<Index, Index>> ends;
-  for (size_t k = 0; k < s.size(); ++k)
-    ends.insert({std::min(s.i[k], s.j[k]), std::max(s.i[k], s.j[k])});
-  return ends;
-}
-
 const clothlab::Aerodynamics& aerodynamics_of(const clothlab::World& world) {
-  for (const auto& e : world.force_effects) {
-    if (auto* a = dynamic_cast<const clothlab::Aerodynamics*>(e.get())) return *a;
-  }
+  if (const auto* air = test::find_force_effect<clothlab::Aerodynamics>(world)) return *air;
   FAIL("the scene has no [aerodynamics]");
   throw std::logic_error("unreachable");
 }
@@ -299,7 +279,7 @@ duration = 1
   const Vec3 r = Vec3(0.3, -0.2, 0.1), v = Vec3(1, 2, 3);
   CHECK(clothlab::spring_damper_force(r, r, v, -v, 100, 1, 0).isZero(0.0));
   CHECK(clothlab::spring_damper_force(r, r, v, -v, 100, 1, 0.2).isZero(0.0));
-  for (const std::string& method : all_integrators()) {
+  for (const std::string& method : test::all_integrators()) {
     CAPTURE(method);
     clothlab::Scene scene = scene_with(text, method);
     clothlab::World& world = scene.world;
@@ -366,7 +346,7 @@ wind = [7, -3, 11]
 dt = 0.0005
 duration = 0.25
 )";
-  for (const std::string& method : all_integrators()) {
+  for (const std::string& method : test::all_integrators()) {
     CAPTURE(method);
     clothlab::Scene scene = scene_with(text, method);
     clothlab::World& world = scene.world;
@@ -428,8 +408,7 @@ duration = 0.1
   CHECK(clothlab::aerodynamic_force(x.col(t[0]), x.col(t[1]), x.col(t[2]), wind, wind, wind, wind,
                                     1.225, 1.2)
             .isZero(0.0));
-  for (long s = 0; s < scene.step_count(); ++s)
-    world.step(scene.dt);
+  test::run_to_end(scene);
   CHECK(same_bits(world.particles.v, v0));
 }
 
@@ -545,7 +524,7 @@ max_speed = 100000
 dt = 0.001
 duration = 0.5
 )";
-  for (const std::string& method : all_integrators()) {
+  for (const std::string& method : test::all_integrators()) {
     CAPTURE(method);
     clothlab::Scene scene = scene_with(text, method);
     clothlab::World& world = scene.world;
@@ -722,7 +701,7 @@ rate = 6
 dt = 0.001
 duration = 5
 )";
-  for (const std::string& method : all_integrators()) {
+  for (const std::string& method : test::all_integrators()) {
     CAPTURE(method);
     clothlab::Scene scene = scene_with(text, method);
     clothlab::World& world = scene.world;
@@ -765,7 +744,7 @@ TEST_CASE("hard case: a thrown particle follows x0 + v0 t + g t^2 / 2 with every
   const Vec3 x0(0.5, 2, -1), v0(1, 3, -2);
   const Vec3 exact = x0 + v0 * t + 0.5 * t * t * Vec3(0, -g, 0);
   const Vec3 exact_v = v0 + t * Vec3(0, -g, 0);
-  for (const std::string& method : all_integrators()) {
+  for (const std::string& method : test::all_integrators()) {
     CAPTURE(method);
     clothlab::World world = test::falling_particle(method, 0.3, x0, g);
     world.particles.v.col(0) = v0;
@@ -794,42 +773,24 @@ TEST_CASE("hard case: a thrown particle follows x0 + v0 t + g t^2 / 2 with every
 // 11. A tearing cascade does not depend on spring order.
 
 TEST_CASE("hard case: a tearing cascade tears the same springs whatever their order") {
-  // tearing.cpp checks one tearing pass on a reversed list. Here a whole run: the sheet from
-  // tearing.cpp's storm tears over 1.5 s, once with its springs as built, once reversed, once
-  // shuffled (std::mt19937, seed 2718) with every other spring's ends swapped. The springs
-  // torn by the end, as (smaller, larger) particle pairs, must be the same set in all three.
+  // tearing.cpp checks one tearing pass on a reversed list. Here a whole run: the sheet in
+  // tearing.cpp's storm (test::storm) tears over 1.5 s, once with its springs as built, once
+  // reversed, once shuffled (std::mt19937, seed 2718) with every other spring's ends swapped.
+  // The springs torn by the end, as (smaller, larger) particle pairs, must be the same set in
+  // all three.
   // The order changes how each particle's spring forces are summed, so the three runs drift
   // apart by rounding (by a few micrometres at the end); the tears, 107 of the 506 springs,
   // must not.
-  const std::string text = R"(
-[cloth]
-rows = 12
-cols = 12
-spacing = 0.05
-mass = 0.15
-pins = "top-edge"
-[springs]
-ks = 40
-kd = 0.02
-[gravity]
-[aerodynamics]
-wind = [0, 0, 30]
-[tearing]
-strain = 0.25
-[integrator]
-dt = 0.0002
-duration = 1.5
-)";
+  const std::string text = test::storm("[tearing]\nstrain = 0.25\n");
   const auto torn_in = [&](const std::function<void(clothlab::SpringSet&)>& reorder) {
     clothlab::Scene scene = scene_with(text, "symplectic-euler");
-    clothlab::SpringSet& s = springs_of(scene.world);
-    const auto built = ends_of(s);
+    clothlab::SpringSet& s = test::springs_of(scene.world);
+    const auto built = test::ends_of(s);
     reorder(s);
-    REQUIRE(ends_of(s) == built);
-    for (long step = 0; step < scene.step_count(); ++step)
-      scene.world.step(scene.dt);
+    REQUIRE(test::ends_of(s) == built);
+    test::run_to_end(scene);
     std::set<std::pair<Index, Index>> torn;
-    const auto left = ends_of(s);
+    const auto left = test::ends_of(s);
     std::set_difference(built.begin(), built.end(), left.begin(), left.end(),
                         std::inserter(torn, torn.begin()));
     return torn;
@@ -934,7 +895,7 @@ duration = 20
                                      "symplectic-euler");
   clothlab::World& world = scene.world;
   world.force_effects.push_back(std::make_unique<CyclicLoad>(world, 1, 60.0, 20.0, 2.0));
-  const clothlab::SpringSet& s = springs_of(world);
+  const clothlab::SpringSet& s = test::springs_of(world);
   const double l_built = s.l_built[0];
   const double lowest = l_built * (1.0 - 0.3), highest = l_built * (1.0 + 0.3);
   double l0_min = l_built, l0_max = l_built;
@@ -1123,7 +1084,7 @@ strain = 0.3
 dt = 0.0005
 duration = 0.5
 )";
-  for (const std::string& method : all_integrators()) {
+  for (const std::string& method : test::all_integrators()) {
     CAPTURE(method);
     clothlab::Scene a = scene_with(text, method);
     clothlab::Scene b = scene_with(text, method);
@@ -1133,7 +1094,7 @@ duration = 0.5
     }
     CHECK(same_bits(a.world.particles.x, b.world.particles.x));
     CHECK(same_bits(a.world.particles.v, b.world.particles.v));
-    CHECK(springs_of(a.world).l0 == springs_of(b.world).l0);
+    CHECK(test::springs_of(a.world).l0 == test::springs_of(b.world).l0);
     // The run did something: the cloth moved away from where it was built.
     clothlab::Scene c = scene_with(text, method);
     CHECK((a.world.particles.x - c.world.particles.x).colwise().norm().maxCoeff() > 0.05);

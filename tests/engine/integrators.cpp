@@ -11,6 +11,7 @@
 #include <doctest/doctest.h>
 
 #include <cmath>
+#include <map>
 #include <memory>
 #include <random>
 #include <string>
@@ -23,16 +24,13 @@
 #include "clothlab/scene.hpp"
 #include "clothlab/spring_damper.hpp"
 #include "clothlab/world.hpp"
+#include "test_util.hpp"
 
 using clothlab::Index;
 using clothlab::Vec3;
 using clothlab::World;
 
 namespace {
-
-const std::vector<std::string> kMethods = {
-    "explicit-euler",  "symplectic-euler", "midpoint",      "rk4",
-    "velocity-verlet", "position-verlet",  "implicit-euler"};
 
 // The named integrator; the implicit one solves to 1e-13, so its error is the method's alone.
 std::unique_ptr<clothlab::Integrator> tight_integrator(const std::string& method) {
@@ -48,14 +46,7 @@ std::unique_ptr<clothlab::Integrator> tight_integrator(const std::string& method
 // The oscillator above: mass m [kg], spring ks [N/m], damper kd [N s/m], starting at
 // displacement x0 [m] from rest with velocity v0 [m/s].
 World oscillator(const std::string& method, double m, double ks, double kd, double x0, double v0) {
-  World world;
-  world.particles.add(Vec3::Zero(), Vec3::Zero(), 1.0);
-  clothlab::pin(world.particles, 0);
-  world.particles.add(Vec3(1.0 + x0, 0.0, 0.0), Vec3(v0, 0.0, 0.0), m);
-  clothlab::SpringSet springs;
-  springs.add(0, 1, ks, kd, 1.0, world.particles.x);
-  world.force_effects.push_back(
-      std::make_unique<clothlab::SpringDampers>("springs", std::move(springs)));
+  World world = test::anchored_spring(m, ks, kd, x0, v0);
   world.integrator = tight_integrator(method);
   return world;
 }
@@ -83,22 +74,33 @@ Exact damped_oscillator(double w, double zeta, double x0, double v0, double t) {
           decay * (v0 * c - (w * w * x0 + s * v0) / wd * sn)};
 }
 
-// A free square of cloth, rows x cols, structural and shear springs with dampers, no pins.
-World free_cloth(const std::string& method, Index rows, Index cols) {
-  World world;
+// Adds to `world` a rows x cols cloth `spacing` [m] apart, of `mass` [kg] in all, with
+// structural springs of ks and shear springs of shear_ks [N/m], every one with the damper kd
+// [N s/m], as the effect "springs". No pins, no other effect; returns the cloth's grid.
+clothlab::ClothGrid add_spring_cloth(World& world, Index rows, Index cols, double spacing,
+                                     double mass, double ks, double shear_ks, double kd) {
   clothlab::ClothSpec spec;
   spec.rows = rows;
   spec.cols = cols;
-  spec.spacing = 0.2;
-  spec.mass = 0.1 * static_cast<double>(rows * cols);
+  spec.spacing = spacing;
+  spec.mass = mass;
   const clothlab::ClothGrid grid = clothlab::add_cloth(world.particles, spec);
   clothlab::SpringSet springs;
-  clothlab::add_spring_family(springs, clothlab::structural_pairs(rows, cols), grid.first, 40.0,
-                              0.05, world.particles.x);
-  clothlab::add_spring_family(springs, clothlab::shear_pairs(rows, cols), grid.first, 20.0, 0.05,
+  clothlab::add_spring_family(springs, clothlab::structural_pairs(rows, cols), grid.first, ks, kd,
+                              world.particles.x);
+  clothlab::add_spring_family(springs, clothlab::shear_pairs(rows, cols), grid.first, shear_ks, kd,
                               world.particles.x);
   world.force_effects.push_back(
       std::make_unique<clothlab::SpringDampers>("springs", std::move(springs)));
+  return grid;
+}
+
+// A free square of cloth, rows x cols, structural and shear springs with dampers, no pins.
+World free_cloth(const std::string& method, Index rows, Index cols) {
+  // 20 cm apart, 0.1 kg a particle; ks = 40 N/m (shear 20 N/m), kd = 0.05 N s/m.
+  World world;
+  add_spring_cloth(world, rows, cols, 0.2, 0.1 * static_cast<double>(rows * cols), 40.0, 20.0,
+                   0.05);
   world.integrator = tight_integrator(method);
   return world;
 }
@@ -243,16 +245,19 @@ TEST_CASE("integrators: force evaluations per step") {
   // What a step costs: Euler and position Verlet evaluate forces once, midpoint and velocity
   // Verlet twice (verlet.hpp: a second time at the new positions), RK4 four times, implicit
   // Euler once (plus its Jacobians and a linear solve, which compute_forces does not count).
-  const int expected[] = {1, 1, 2, 4, 2, 1, 1};
-  for (size_t k = 0; k < kMethods.size(); ++k) {
-    CAPTURE(kMethods[k]);
-    World world = free_cloth(kMethods[k], 3, 3);
+  const std::map<std::string, int> evaluations = {
+      {"explicit-euler", 1},  {"symplectic-euler", 1}, {"midpoint", 2},      {"rk4", 4},
+      {"velocity-verlet", 2}, {"position-verlet", 1},  {"implicit-euler", 1}};
+  for (const std::string& method : test::all_integrators()) {
+    CAPTURE(method);
+    const int expected = evaluations.at(method);  // every method must be listed above
+    World world = free_cloth(method, 3, 3);
     world.force_effects.push_back(std::make_unique<clothlab::UniformGravity>(Vec3(0.0, -9.8, 0.0)));
-    CHECK(world.integrator->force_evaluations_per_step() == expected[k]);
+    CHECK(world.integrator->force_evaluations_per_step() == expected);
     CHECK(world.force_evaluations == 0);
     for (int s = 0; s < 10; ++s)
       world.step(1e-3);
-    CHECK(world.force_evaluations == 10L * expected[k]);
+    CHECK(world.force_evaluations == 10L * expected);
     CHECK(world.force_evaluations == 10L * world.integrator->force_evaluations_per_step());
   }
 }
@@ -266,7 +271,7 @@ TEST_CASE("integrators: internal forces conserve momentum under every method") {
   // Rounding allows 1e-13 of sum m |v|, except for position Verlet: its velocity is the
   // difference quotient (x' - x) / dt, whose rounding is 1.1e-16 |x| / dt ~ 1e-13 m/s per
   // particle at dt = 5e-4 s, whatever the momentum; it is allowed 2e-12.
-  for (const std::string& method : kMethods) {
+  for (const std::string& method : test::all_integrators()) {
     CAPTURE(method);
     World world = free_cloth(method, 3, 3);
     std::mt19937 random(7);
@@ -352,22 +357,11 @@ TEST_CASE("integrators: pinned particles stay exactly where they are under every
   // its position is updated by exact zeros (position Verlet: 2x - x_prev with x_prev = x,
   // exact in floating point). It must not move by even one bit, however hard its springs,
   // gravity and damping pull on it.
-  for (const std::string& method : kMethods) {
+  for (const std::string& method : test::all_integrators()) {
     CAPTURE(method);
+    // 4 x 4 particles 10 cm apart, 0.4 kg; ks = 60 N/m (shear 30 N/m), kd = 0.02 N s/m.
     World world;
-    clothlab::ClothSpec spec;
-    spec.rows = 4;
-    spec.cols = 4;
-    spec.spacing = 0.1;
-    spec.mass = 0.4;
-    const clothlab::ClothGrid grid = clothlab::add_cloth(world.particles, spec);
-    clothlab::SpringSet springs;
-    clothlab::add_spring_family(springs, clothlab::structural_pairs(4, 4), grid.first, 60.0, 0.02,
-                                world.particles.x);
-    clothlab::add_spring_family(springs, clothlab::shear_pairs(4, 4), grid.first, 30.0, 0.02,
-                                world.particles.x);
-    world.force_effects.push_back(
-        std::make_unique<clothlab::SpringDampers>("springs", std::move(springs)));
+    const clothlab::ClothGrid grid = add_spring_cloth(world, 4, 4, 0.1, 0.4, 60.0, 30.0, 0.02);
     world.force_effects.push_back(std::make_unique<clothlab::UniformGravity>(Vec3(0.0, -9.8, 0.0)));
     world.force_effects.push_back(std::make_unique<clothlab::Damping>(0.5));
     world.integrator = clothlab::make_integrator(method);
@@ -451,20 +445,9 @@ namespace {
 // A hanging cloth with pinned top corners, for the topology tests: the same world can be built
 // twice and given another's state.
 World hanging_cloth() {
+  // 4 x 5 particles 10 cm apart, 0.5 kg; ks = 500 N/m (shear 200 N/m), kd = 0.5 N s/m.
   World world;
-  clothlab::ClothSpec spec;
-  spec.rows = 4;
-  spec.cols = 5;
-  spec.spacing = 0.1;
-  spec.mass = 0.5;
-  const clothlab::ClothGrid grid = clothlab::add_cloth(world.particles, spec);
-  clothlab::SpringSet springs;
-  clothlab::add_spring_family(springs, clothlab::structural_pairs(4, 5), grid.first, 500.0, 0.5,
-                              world.particles.x);
-  clothlab::add_spring_family(springs, clothlab::shear_pairs(4, 5), grid.first, 200.0, 0.5,
-                              world.particles.x);
-  world.force_effects.push_back(
-      std::make_unique<clothlab::SpringDampers>("springs", std::move(springs)));
+  const clothlab::ClothGrid grid = add_spring_cloth(world, 4, 5, 0.1, 0.5, 500.0, 200.0, 0.5);
   world.force_effects.push_back(std::make_unique<clothlab::UniformGravity>(Vec3(0.0, -9.8, 0.0)));
   clothlab::pin(world.particles, grid.at(0, 0));
   clothlab::pin(world.particles, grid.at(0, 4));

@@ -6,13 +6,13 @@
 #include <cstdint>
 #include <memory>
 #include <set>
-#include <stdexcept>
 #include <string>
 
 #include "clothlab/scene.hpp"
 #include "clothlab/solid.hpp"
 #include "clothlab/spring_damper.hpp"
 #include "clothlab/strain_limiting.hpp"
+#include "test_util.hpp"
 
 using clothlab::Index;
 using clothlab::IndexPair;
@@ -20,23 +20,13 @@ using clothlab::Vec3;
 
 namespace {
 
-const clothlab::SpringSet& springs_of(const clothlab::World& world) {
-  for (const auto& e : world.force_effects) {
-    if (e->name() == "springs") return dynamic_cast<const clothlab::SpringDampers&>(*e).springs();
-  }
-  throw std::logic_error("no springs");
-}
-
 clothlab::StrainLimiting* limiter_of(clothlab::World& world) {
-  for (auto& e : world.post_step_effects) {
-    if (auto* s = dynamic_cast<clothlab::StrainLimiting*>(e.get())) return s;
-  }
-  return nullptr;
+  return test::find_post_step_effect<clothlab::StrainLimiting>(world);
 }
 
 // The sum over the springs of how far each is past 1.1 l0, relative to l0.
 double total_excess(const clothlab::World& world) {
-  const clothlab::SpringSet& s = springs_of(world);
+  const clothlab::SpringSet& s = test::springs_of(world);
   double sum = 0.0;
   for (size_t k = 0; k < s.size(); ++k) {
     const double l = (world.particles.x.col(s.j[k]) - world.particles.x.col(s.i[k])).norm();
@@ -47,7 +37,7 @@ double total_excess(const clothlab::World& world) {
 
 // The largest l / l0 - 1 over the springs.
 double max_strain(const clothlab::World& world) {
-  const clothlab::SpringSet& s = springs_of(world);
+  const clothlab::SpringSet& s = test::springs_of(world);
   double worst = -1.0;
   for (size_t k = 0; k < s.size(); ++k) {
     const double l = (world.particles.x.col(s.j[k]) - world.particles.x.col(s.i[k])).norm();
@@ -260,9 +250,8 @@ TEST_CASE("solid: a jelly cube dropped on the ground stays finite and comes to r
                                                     "/lessons/09-ropes-and-solids/jelly-cube.toml");
   clothlab::World& w = scene.world;
   REQUIRE(scene.solid);
-  CHECK(springs_of(w).size() == 300 + 480 + 256);  // a 5 x 5 x 5 lattice, see the scene
-  for (long n = 0; n < scene.step_count(); ++n)
-    w.step(scene.dt);
+  CHECK(test::springs_of(w).size() == 300 + 480 + 256);  // a 5 x 5 x 5 lattice, see the scene
+  test::run_to_end(scene);
   const clothlab::Matrix3X& x = w.particles.x;
   CHECK(x.allFinite());
   CHECK(w.particles.v.allFinite());

@@ -11,6 +11,7 @@
 #include "clothlab/scene.hpp"
 #include "clothlab/self_collision.hpp"
 #include "clothlab/spatial_hash.hpp"
+#include "test_util.hpp"
 
 using clothlab::Index;
 using clothlab::IndexPair;
@@ -50,10 +51,7 @@ std::vector<IndexPair> brute_pairs(const Matrix3X& x, double h) {
 }
 
 clothlab::SelfCollision* self_collision_of(clothlab::World& world) {
-  for (auto& e : world.post_step_effects) {
-    if (auto* s = dynamic_cast<clothlab::SelfCollision*>(e.get())) return s;
-  }
-  return nullptr;
+  return test::find_post_step_effect<clothlab::SelfCollision>(world);
 }
 
 // The smallest distance [m] between two particles that were at least `thickness` apart at rest

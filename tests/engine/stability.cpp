@@ -33,6 +33,7 @@
 #include "clothlab/implicit_euler.hpp"
 #include "clothlab/spring_damper.hpp"
 #include "clothlab/world.hpp"
+#include "test_util.hpp"
 
 using clothlab::Vec3;
 using clothlab::World;
@@ -50,28 +51,13 @@ double damper_for(double zeta) {
   return 2.0 * zeta * std::sqrt(kStiffness * kMass);  // kd = 2 zeta sqrt(ks m) [N s/m]
 }
 
-// Particle 1 (mass m1 [kg]) starts at displacement x0 [m] from rest with velocity v0 [m/s].
-// With m0 = 0 particle 0 is the pinned anchor; otherwise it is free, of mass m0, and moves
-// so that the pair's momentum is zero: then the stretch obeys the oscillator above with the
-// reduced mass m0 m1 / (m0 + m1) in place of m.
+// test::spring_pair with the named integrator, the implicit one solving to 1e-13: particle 1
+// (mass m1 [kg]) starts at displacement x0 [m] with velocity v0 [m/s]; with m0 = 0 particle 0
+// is the pinned anchor, otherwise a free mass m0, and the stretch obeys the oscillator above
+// with the reduced mass m0 m1 / (m0 + m1) in place of m.
 World spring_pair(const std::string& method, double m0, double m1, double ks, double kd, double x0,
                   double v0) {
-  World world;
-  world.particles.add(Vec3::Zero(), Vec3::Zero(), m0 > 0.0 ? m0 : 1.0);
-  if (m0 > 0.0) {
-    const double share = m1 / (m0 + m1);  // the anchor's part of the relative motion
-    world.particles.x(0, 0) = -share * x0;
-    world.particles.v(0, 0) = -share * v0;
-    x0 *= 1.0 - share;
-    v0 *= 1.0 - share;
-  } else {
-    clothlab::pin(world.particles, 0);
-  }
-  world.particles.add(Vec3(1.0 + x0, 0.0, 0.0), Vec3(v0, 0.0, 0.0), m1);
-  clothlab::SpringSet springs;
-  springs.add(0, 1, ks, kd, 1.0, world.particles.x);
-  world.force_effects.push_back(
-      std::make_unique<clothlab::SpringDampers>("springs", std::move(springs)));
+  World world = test::spring_pair(m0, m1, ks, kd, x0, v0);
   world.integrator = clothlab::make_integrator(method);
   REQUIRE(world.integrator != nullptr);
   if (auto* implicit = dynamic_cast<clothlab::ImplicitEuler*>(world.integrator.get()))

@@ -11,52 +11,14 @@
 #include "clothlab/scene.hpp"
 #include "clothlab/spring_damper.hpp"
 #include "clothlab/tearing.hpp"
+#include "test_util.hpp"
 
 using clothlab::Index;
 
-namespace {
-
-// A sheet hanging from its top edge in a storm: it stretches, yields and tears.
-std::string storm(const std::string& extra) {
-  return R"(
-[cloth]
-rows = 12
-cols = 12
-spacing = 0.05
-mass = 0.15
-pins = "top-edge"
-[springs]
-ks = 40
-kd = 0.02
-[gravity]
-[aerodynamics]
-wind = [0, 0, 30]
-[integrator]
-dt = 0.0002
-duration = 1.5
-)" + extra;
-}
-
-clothlab::SpringDampers& springs_of(clothlab::World& world) {
-  for (auto& e : world.force_effects) {
-    if (e->name() == "springs") return dynamic_cast<clothlab::SpringDampers&>(*e);
-  }
-  throw std::logic_error("no springs");
-}
-
-std::set<std::pair<Index, Index>> ends_of(const clothlab::SpringSet& s) {
-  std::set<std::pair<Index, Index>> ends;
-  for (size_t k = 0; k < s.size(); ++k)
-    ends.insert({std::min(s.i[k], s.j[k]), std::max(s.i[k], s.j[k])});
-  return ends;
-}
-
-}  // namespace
-
 TEST_CASE("plasticity: rest lengths stay positive and never pass the current length") {
   clothlab::Scene scene = clothlab::parse_scene(
-      storm("[plasticity]\nyield_strain = 0.05\nmax_strain = 0.5\n"), "p.toml");
-  clothlab::SpringSet& s = springs_of(scene.world).springs();
+      test::storm("[plasticity]\nyield_strain = 0.05\nmax_strain = 0.5\n"), "p.toml");
+  clothlab::SpringSet& s = test::springs_of(scene.world);
   for (long step = 0; step < scene.step_count(); ++step) {
     scene.world.step(scene.dt);
     bool positive = true, finite = true, within = true;
@@ -81,10 +43,10 @@ TEST_CASE("plasticity: rest lengths stay positive and never pass the current len
 TEST_CASE("plasticity: plastic flow never adds energy to a spring") {
   // Apply only the plastic update to a stretched state and compare the springs' energy.
   clothlab::Scene scene =
-      clothlab::parse_scene(storm("[plasticity]\nyield_strain = 0.02\n"), "p.toml");
+      clothlab::parse_scene(test::storm("[plasticity]\nyield_strain = 0.02\n"), "p.toml");
   for (int step = 0; step < 2000; ++step)
     scene.world.step(scene.dt);  // the storm stretches it
-  clothlab::SpringDampers& springs = springs_of(scene.world);
+  clothlab::SpringDampers& springs = test::spring_effect(scene.world);
   const double before = springs.potential_energy(scene.world.particles, scene.world.particles.x);
   clothlab::Plasticity plasticity({0.02, 1e9, 0.9});  // flow all the way at once
   plasticity.apply(scene.world, scene.dt);
@@ -95,18 +57,19 @@ TEST_CASE("plasticity: plastic flow never adds energy to a spring") {
 
 TEST_CASE("plasticity: below the elastic limit nothing changes") {
   // A breeze instead of the storm: the sheet stretches by a few percent, far below 50 %.
-  std::string breeze = storm("[plasticity]\nyield_strain = 0.5\n");
+  std::string breeze = test::storm("[plasticity]\nyield_strain = 0.5\n");
   breeze.replace(breeze.find("wind = [0, 0, 30]"), 17, "wind = [0, 0, 2]");
   clothlab::Scene scene = clothlab::parse_scene(breeze, "p.toml");
-  const clothlab::SpringSet& s = springs_of(scene.world).springs();
+  const clothlab::SpringSet& s = test::springs_of(scene.world);
   for (int step = 0; step < 2000; ++step)
     scene.world.step(scene.dt);
   CHECK(std::memcmp(s.l0.data(), s.l_built.data(), s.size() * sizeof(double)) == 0);
 }
 
 TEST_CASE("tearing: springs only go, no index dangles, and torn triangles leave the air") {
-  clothlab::Scene scene = clothlab::parse_scene(storm("[tearing]\nstrain = 0.25\n"), "t.toml");
-  clothlab::SpringSet& s = springs_of(scene.world).springs();
+  clothlab::Scene scene =
+      clothlab::parse_scene(test::storm("[tearing]\nstrain = 0.25\n"), "t.toml");
+  clothlab::SpringSet& s = test::springs_of(scene.world);
   const size_t springs_at_start = s.size();
   const Index n = scene.world.particles.size();
   size_t previous = s.size();
@@ -121,11 +84,8 @@ TEST_CASE("tearing: springs only go, no index dangles, and torn triangles leave 
     CHECK(s.j[k] < n);
   }
   // Every remaining triangle keeps all three of its edges as springs (structural or shear).
-  const auto ends = ends_of(s);
-  const clothlab::Aerodynamics* aero = nullptr;
-  for (const auto& e : scene.world.force_effects) {
-    if (auto* a = dynamic_cast<const clothlab::Aerodynamics*>(e.get())) aero = a;
-  }
+  const auto ends = test::ends_of(s);
+  const auto* aero = test::find_force_effect<clothlab::Aerodynamics>(scene.world);
   REQUIRE(aero != nullptr);
   CHECK(aero->triangles() == scene.world.triangles);
   CHECK(scene.world.triangles.size() < 2u * 11u * 11u);
@@ -142,12 +102,12 @@ TEST_CASE("tearing: which springs tear does not depend on their order in the lis
   // must remove the same springs (by their end particles) from both.
   for (size_t max_tears : {size_t{0}, size_t{3}}) {
     CAPTURE(max_tears);
-    clothlab::Scene a = clothlab::parse_scene(storm(""), "a.toml");
+    clothlab::Scene a = clothlab::parse_scene(test::storm(), "a.toml");
     for (int step = 0; step < 3000; ++step)
       a.world.step(a.dt);
-    clothlab::Scene b = clothlab::parse_scene(storm(""), "b.toml");
+    clothlab::Scene b = clothlab::parse_scene(test::storm(), "b.toml");
     b.world.particles = a.world.particles;
-    clothlab::SpringSet& sb = springs_of(b.world).springs();
+    clothlab::SpringSet& sb = test::springs_of(b.world);
     for (auto* column : {&sb.ks, &sb.kd, &sb.l0, &sb.l_built})
       std::reverse(column->begin(), column->end());
     std::reverse(sb.i.begin(), sb.i.end());
@@ -157,13 +117,13 @@ TEST_CASE("tearing: which springs tear does not depend on their order in the lis
     tb.apply(b.world, b.dt);
     CHECK(ta.torn() > 0);
     CHECK(ta.torn() == tb.torn());
-    CHECK(ends_of(springs_of(a.world).springs()) == ends_of(sb));
+    CHECK(test::ends_of(test::springs_of(a.world)) == test::ends_of(sb));
   }
 }
 
 TEST_CASE("tearing: a repeated run is bitwise identical") {
-  clothlab::Scene a = clothlab::parse_scene(storm("[tearing]\nstrain = 0.25\n"), "t.toml");
-  clothlab::Scene b = clothlab::parse_scene(storm("[tearing]\nstrain = 0.25\n"), "t.toml");
+  clothlab::Scene a = clothlab::parse_scene(test::storm("[tearing]\nstrain = 0.25\n"), "t.toml");
+  clothlab::Scene b = clothlab::parse_scene(test::storm("[tearing]\nstrain = 0.25\n"), "t.toml");
   for (long step = 0; step < a.step_count(); ++step) {
     a.world.step(a.dt);
     b.world.step(b.dt);
@@ -171,20 +131,17 @@ TEST_CASE("tearing: a repeated run is bitwise identical") {
   const auto& xa = a.world.particles.x;
   const auto& xb = b.world.particles.x;
   CHECK(std::memcmp(xa.data(), xb.data(), sizeof(double) * static_cast<size_t>(xa.size())) == 0);
-  CHECK(springs_of(a.world).springs().size() == springs_of(b.world).springs().size());
+  CHECK(test::springs_of(a.world).size() == test::springs_of(b.world).size());
 }
 
 TEST_CASE("tearing: bending springs that reach across a tear go with it") {
   // With [bending], every bending spring left must still have both of its halves as springs:
   // otherwise it would hold the two sides of a tear together.
   clothlab::Scene scene =
-      clothlab::parse_scene(storm("[bending]\nks = 2\n[tearing]\nstrain = 0.25\n"), "b.toml");
-  for (long step = 0; step < scene.step_count(); ++step)
-    scene.world.step(scene.dt);
-  const auto ends = ends_of(springs_of(scene.world).springs());
-  const clothlab::SpringDampers* bending = clothlab::find_spring_effect(scene.world, "bending");
-  REQUIRE(bending != nullptr);
-  const clothlab::SpringSet& b = bending->springs();
+      clothlab::parse_scene(test::storm("[bending]\nks = 2\n[tearing]\nstrain = 0.25\n"), "b.toml");
+  test::run_to_end(scene);
+  const auto ends = test::ends_of(test::springs_of(scene.world));
+  const clothlab::SpringSet& b = test::springs_of(scene.world, "bending");
   CHECK(b.size() < 2u * 12u * 10u);  // some went
   for (size_t k = 0; k < b.size(); ++k) {
     const Index a = std::min(b.i[k], b.j[k]), c = std::max(b.i[k], b.j[k]);

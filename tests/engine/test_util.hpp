@@ -1,14 +1,35 @@
-// test_util.hpp: small helpers shared by the engine tests.
+// test_util.hpp: small helpers shared by the engine tests: the worlds and scenes that several
+// files build, running a scene, and finding an effect in a world.
 #pragma once
 
-#include <memory>
-#include <string>
+#include <doctest/doctest.h>
 
+#include <algorithm>
+#include <memory>
+#include <set>
+#include <string>
+#include <string_view>
+#include <utility>
+#include <vector>
+
+#include "clothlab/cloth.hpp"
 #include "clothlab/euler.hpp"
 #include "clothlab/gravity.hpp"
+#include "clothlab/integrator.hpp"
+#include "clothlab/scene.hpp"
+#include "clothlab/spring_damper.hpp"
 #include "clothlab/world.hpp"
 
 namespace test {
+
+// ---- Integrators ----------------------------------------------------------------------------
+
+// Every integrator a scene may name, in the engine's order (clothlab::integrator_names()).
+inline std::vector<std::string> all_integrators() {
+  return {clothlab::integrator_names().begin(), clothlab::integrator_names().end()};
+}
+
+// ---- Worlds built in code -------------------------------------------------------------------
 
 // One particle of mass m [kg] at rest at x0 under gravity g, with the named integrator.
 inline clothlab::World falling_particle(const std::string& method, double m = 1.0,
@@ -20,6 +41,135 @@ inline clothlab::World falling_particle(const std::string& method, double m = 1.
       std::make_unique<clothlab::UniformGravity>(clothlab::Vec3(0.0, -g, 0.0)));
   world.integrator = clothlab::make_integrator(method);
   return world;
+}
+
+// Two particles on one spring (ks [N/m], kd [N s/m], l0 = 1 m) along x: the 1D oscillator of
+// integrators.cpp, stability.cpp and advisor.cpp. Particle 1 (mass m1 [kg]) starts at
+// displacement x0 [m] from rest with velocity v0 [m/s]. With m0 = 0 particle 0 is the pinned
+// anchor at the origin; otherwise it is free, of mass m0, and moves so that the pair's momentum
+// is zero: then the stretch obeys the oscillator with the reduced mass m0 m1 / (m0 + m1) in
+// place of m1. The world has no integrator yet: each file sets its own.
+inline clothlab::World spring_pair(double m0, double m1, double ks, double kd, double x0,
+                                   double v0) {
+  clothlab::World world;
+  world.particles.add(clothlab::Vec3::Zero(), clothlab::Vec3::Zero(), m0 > 0.0 ? m0 : 1.0);
+  if (m0 > 0.0) {
+    const double share = m1 / (m0 + m1);  // the anchor's part of the relative motion
+    world.particles.x(0, 0) = -share * x0;
+    world.particles.v(0, 0) = -share * v0;
+    x0 *= 1.0 - share;
+    v0 *= 1.0 - share;
+  } else {
+    clothlab::pin(world.particles, 0);
+  }
+  world.particles.add(clothlab::Vec3(1.0 + x0, 0.0, 0.0), clothlab::Vec3(v0, 0.0, 0.0), m1);
+  clothlab::SpringSet springs;
+  springs.add(0, 1, ks, kd, 1.0, world.particles.x);
+  world.force_effects.push_back(
+      std::make_unique<clothlab::SpringDampers>("springs", std::move(springs)));
+  return world;
+}
+
+// The oscillator of spring_pair with its anchor pinned: m x'' = -ks x - kd x', x the
+// displacement of particle 1 (mass m [kg]) from 1 m. No integrator yet.
+inline clothlab::World anchored_spring(double m, double ks, double kd, double x0, double v0) {
+  return spring_pair(0.0, m, ks, kd, x0, v0);
+}
+
+// ---- Scenes ---------------------------------------------------------------------------------
+
+// A sheet of 12 x 12 particles 5 cm apart, 0.15 kg in all, hanging from its top edge in a
+// 30 m/s storm for 1.5 s (tearing.cpp, hard_cases.cpp): with [plasticity] or [tearing] among the
+// extra `tables` it stretches, yields and tears. The text ends inside its [integrator] table
+// (dt and duration), so a test may append keys to it (the method); where a table stands in the
+// text does not matter, the engine reads them in its own order.
+inline std::string storm(const std::string& tables = "") {
+  return R"(
+[cloth]
+rows = 12
+cols = 12
+spacing = 0.05
+mass = 0.15
+pins = "top-edge"
+[springs]
+ks = 40
+kd = 0.02
+[gravity]
+[aerodynamics]
+wind = [0, 0, 30]
+)" + tables +
+         R"(
+[integrator]
+dt = 0.0002
+duration = 1.5
+)";
+}
+
+// Steps `scene` through its whole duration: step_count() steps of its dt.
+inline void run_to_end(clothlab::Scene& scene) {
+  for (long s = 0; s < scene.step_count(); ++s)
+    scene.world.step(scene.dt);
+}
+
+// ---- Finding effects ------------------------------------------------------------------------
+
+// The spring effect of `world` called `name` ("springs" or "bending"); the test case fails
+// (REQUIRE) if there is none.
+inline clothlab::SpringDampers& spring_effect(clothlab::World& world,
+                                              std::string_view name = "springs") {
+  clothlab::SpringDampers* springs = clothlab::find_spring_effect(world, name);
+  REQUIRE(springs != nullptr);
+  return *springs;
+}
+
+inline const clothlab::SpringDampers& spring_effect(const clothlab::World& world,
+                                                    std::string_view name = "springs") {
+  const clothlab::SpringDampers* springs = nullptr;
+  for (const auto& e : world.force_effects) {
+    if (e->name() == name) {
+      springs = dynamic_cast<const clothlab::SpringDampers*>(e.get());
+      break;
+    }
+  }
+  REQUIRE(springs != nullptr);
+  return *springs;
+}
+
+// The springs of the spring effect `name`, as spring_effect finds it.
+inline clothlab::SpringSet& springs_of(clothlab::World& world, std::string_view name = "springs") {
+  return spring_effect(world, name).springs();
+}
+
+inline const clothlab::SpringSet& springs_of(const clothlab::World& world,
+                                             std::string_view name = "springs") {
+  return spring_effect(world, name).springs();
+}
+
+// Each spring as the pair (smaller, larger) of its end particles: the same set whatever the
+// springs' order in the list and whichever end each lists first.
+inline std::set<std::pair<clothlab::Index, clothlab::Index>> ends_of(const clothlab::SpringSet& s) {
+  std::set<std::pair<clothlab::Index, clothlab::Index>> ends;
+  for (size_t k = 0; k < s.size(); ++k)
+    ends.insert({std::min(s.i[k], s.j[k]), std::max(s.i[k], s.j[k])});
+  return ends;
+}
+
+// The first force effect of `world` that is a T (clothlab::Aerodynamics, ...), or nullptr.
+template <class T>
+const T* find_force_effect(const clothlab::World& world) {
+  for (const auto& e : world.force_effects) {
+    if (const auto* found = dynamic_cast<const T*>(e.get())) return found;
+  }
+  return nullptr;
+}
+
+// The first post-step effect of `world` that is a T (clothlab::SelfCollision, ...), or nullptr.
+template <class T>
+T* find_post_step_effect(clothlab::World& world) {
+  for (auto& e : world.post_step_effects) {
+    if (auto* found = dynamic_cast<T*>(e.get())) return found;
+  }
+  return nullptr;
 }
 
 }  // namespace test
