@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <atomic>
+#include <functional>
 #include <memory>
 #include <numeric>
 #include <random>
@@ -66,9 +67,12 @@ duration = 1.0
 )" + extra;
 }
 
-// The scene stepped `steps` times with the given engine settings.
-clothlab::Scene run(const std::string& text, bool fast, int threads, int steps) {
+// The scene stepped `steps` times with the given engine settings, after `edit` (if given) has
+// changed its world.
+clothlab::Scene run(const std::string& text, bool fast, int threads, int steps,
+                    const std::function<void(clothlab::World&)>& edit = {}) {
   clothlab::Scene scene = clothlab::parse_scene(text, "fast-path.toml");
+  if (edit) edit(scene.world);
   scene.world.fast_path = fast;
   scene.world.threads = threads;
   for (int s = 0; s < steps; ++s)
@@ -185,19 +189,13 @@ TEST_CASE("fast path: effects without a fast path, between and after those with 
   const std::string text = cloth("");
   for (int threads : {1, 2}) {
     CAPTURE(threads);
-    std::vector<clothlab::Scene> scenes;
-    for (bool fast : {false, true}) {
-      clothlab::Scene scene = clothlab::parse_scene(text, "fast-path.toml");
-      auto& effects = scene.world.force_effects;
-      effects.insert(effects.begin() + 1, std::make_unique<PullToOrigin>());
-      scene.world.fast_path = fast;
-      scene.world.threads = threads;
-      for (int s = 0; s < 100; ++s)
-        scene.world.step(scene.dt);
-      scenes.push_back(std::move(scene));
-    }
-    const clothlab::World& readable = scenes[0].world;
-    const clothlab::World& fast = scenes[1].world;
+    const auto add_pull = [](clothlab::World& w) {
+      w.force_effects.insert(w.force_effects.begin() + 1, std::make_unique<PullToOrigin>());
+    };
+    const clothlab::Scene readable_scene = run(text, false, threads, 100, add_pull);
+    const clothlab::Scene fast_scene = run(text, true, threads, 100, add_pull);
+    const clothlab::World& readable = readable_scene.world;
+    const clothlab::World& fast = fast_scene.world;
     std::string soa;  // which effects have a fast path, in the world's order
     for (const auto& e : fast.force_effects)
       soa += std::string(e->name()) + (e->adds_soa(fast.particles) ? "+ " : "- ");
@@ -218,19 +216,14 @@ TEST_CASE("fast path: the Euler methods move particles in the pass that sums the
     for (int threads : {1, 2, 3}) {
       CAPTURE(method);
       CAPTURE(threads);
-      std::vector<clothlab::Scene> scenes;
-      for (bool fast : {false, true}) {
-        clothlab::Scene scene = clothlab::parse_scene(cloth("", method), "fast-path.toml");
-        std::erase_if(scene.world.force_effects,
-                      [](const auto& e) { return e->name() == "buoyancy"; });
-        scene.world.fast_path = fast;
-        scene.world.threads = threads;
-        for (int s = 0; s < 30; ++s)
-          scene.world.step(scene.dt);
-        scenes.push_back(std::move(scene));
-      }
-      const clothlab::World& readable = scenes[0].world;
-      const clothlab::World& fast = scenes[1].world;
+      const auto no_buoyancy = [](clothlab::World& w) {
+        std::erase_if(w.force_effects, [](const auto& e) { return e->name() == "buoyancy"; });
+      };
+      const clothlab::Scene readable_scene =
+          run(cloth("", method), false, threads, 30, no_buoyancy);
+      const clothlab::Scene fast_scene = run(cloth("", method), true, threads, 30, no_buoyancy);
+      const clothlab::World& readable = readable_scene.world;
+      const clothlab::World& fast = fast_scene.world;
       REQUIRE(fast.force_effects.back()->adds_soa(fast.particles));
       CHECK(fast.fast_evaluations == fast.force_evaluations);
       CHECK(identical(fast.particles.x, readable.particles.x));
