@@ -28,18 +28,22 @@ void SelfCollision::apply(World& world, double /*dt*/) {
     ++last_passes_;
     if (pass == 0) last_pairs_ = pairs_.size();
     if (pairs_.empty()) break;  // nothing closer than the thickness: done
-    // Gauss-Seidel, as in strain limiting: each pair sees the corrections of the pairs before it.
-    for (const auto& [i, j] : pairs_) {
-      const double w1 = p.inv_m[i], w2 = p.inv_m[j];
-      if (w1 + w2 == 0.0) continue;  // two pinned particles: nothing can move
-      const PairState out =
-          pair_response({p.x.col(i), p.v.col(i), p.x.col(j), p.v.col(j)}, w1, w2, contact_);
-      p.x.col(i) = out.r1;
-      p.v.col(i) = out.v1;
-      p.x.col(j) = out.r2;
-      p.v.col(j) = out.v2;
-    }
+    respond(p, pairs_);
     total_pairs_ += static_cast<long>(pairs_.size());
+  }
+}
+
+void SelfCollision::respond(Particles& p, const std::vector<IndexPair>& pairs) const {
+  // Gauss-Seidel, as in strain limiting: each pair sees the corrections of the pairs before it.
+  for (const auto& [i, j] : pairs) {
+    const double w1 = p.inv_m[i], w2 = p.inv_m[j];
+    if (w1 + w2 == 0.0) continue;  // two pinned particles: nothing can move
+    const PairState out =
+        pair_response({p.x.col(i), p.v.col(i), p.x.col(j), p.v.col(j)}, w1, w2, contact_);
+    p.x.col(i) = out.r1;
+    p.v.col(i) = out.v1;
+    p.x.col(j) = out.r2;
+    p.v.col(j) = out.v2;
   }
 }
 

@@ -69,6 +69,10 @@ class SelfCollision final : public PostStepEffect {
   // returns every pair i < j closer than the thickness that is not excluded at rest.
   const std::vector<IndexPair>& detect(const Matrix3X& x, double bound);
 
+  // Response alone: each pair, in the order given, through pair_response (exercise 10.2), the
+  // particles' x and v updated before the next pair is taken (Gauss-Seidel).
+  void respond(Particles& p, const std::vector<IndexPair>& pairs) const;
+
   // True when particles i and j are closer than the thickness at rest, and so never collide.
   bool excluded(Index i, Index j) const {
     return (x_rest_.col(j) - x_rest_.col(i)).squaredNorm() <

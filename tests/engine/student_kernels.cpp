@@ -25,7 +25,7 @@ std::string stops_at(F&& run) {
 
 }  // namespace
 
-TEST_CASE("student build: [self_collision] calls the student's hash kernel (ex10.1)") {
+TEST_CASE("student build: [self_collision] calls the student's kernels (ex10.1, ex10.2)") {
   clothlab::Scene scene = clothlab::parse_scene(R"(
 [[particle]]
 position = [0.0, 0.0, 0.0]
@@ -48,4 +48,9 @@ duration = 1
   // stubs too, so the step itself would stop at lesson 01).
   CHECK(stops_at([&] { effect->apply(w, scene.dt); }) == "ex10.1");
   CHECK(stops_at([&] { effect->detect(w.particles.x, 1e6); }) == "ex10.1");
+  // The response, given the pair that detection finds once ex10.1 is done: the two particles
+  // brought within the thickness (0.01 m apart, thickness 0.05 m) go through the student's
+  // pair_response.
+  w.particles.x(1, 1) = 0.01;
+  CHECK(stops_at([&] { effect->respond(w.particles, {{0, 1}}); }) == "ex10.2");
 }
