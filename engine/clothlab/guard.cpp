@@ -37,8 +37,7 @@ Index first_bad_column(const Matrix3X& a, double bound) {
 }  // namespace
 
 bool Guard::within(const Matrix3X& x, const Matrix3X& v, Index begin, Index end) const {
-  // Both tests always run: no branch between them, and the compiler vectorises each.
-  return all_within(x, begin, end, max_position) & all_within(v, begin, end, max_speed);
+  return all_within(x, begin, end, max_position) && all_within(v, begin, end, max_speed);
 }
 
 void Guard::check(const World& world, bool before_step) const {
