@@ -62,8 +62,8 @@ void fast_forces(const World& world, const Matrix3X& x, const Matrix3X& v, Matri
                  const std::function<void(Index begin, Index end)>* move = nullptr,
                  StepChecks* checks = nullptr);
 
-// Particles a thread copies, checks or moves at once: their x, v and f (36 KiB) stay in the
-// first-level and second-level caches from one to the next.
+// Particles a thread copies, checks or moves at once: their x, v and f in the engine's layout
+// (36 KiB) stay in the second-level cache from one of these to the next.
 inline constexpr Index kPassChunk = 512;
 
 }  // namespace clothlab

@@ -67,8 +67,9 @@ class World {
   // compute_forces, then move(begin, end) on contiguous ranges of particles that cover them all
   // once, as for_particles does: an integrator's update, which may read f and change the state
   // of particles [begin, end) only. On the fast path each thread moves its own particles as soon
-  // as their forces are summed, a few hundred at a time, in the same pass over them: the forces
-  // are still in the cache, and the threads meet once instead of twice.
+  // as their forces are summed, a few hundred at a time, in the same pass over them, and the
+  // guard can check each particle there (World::step). So with threads, if an effect throws
+  // (an exercise not done yet), the particles of the other threads may have moved already.
   void compute_forces_then(const Matrix3X& x, const Matrix3X& v, Matrix3X& f,
                            const std::function<void(Index begin, Index end)>& move) const;
 
