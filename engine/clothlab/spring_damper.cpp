@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <atomic>
 #include <cassert>
+#include <utility>
 
 #include "clothlab/world.hpp"
 
@@ -76,11 +77,15 @@ void add_spring_family(SpringSet& springs, const std::vector<std::pair<Index, In
     springs.add(first + a, first + b, ks, kd, -1.0, x);
 }
 
-SpringDampers* find_spring_effect(World& world, std::string_view name) {
-  for (auto& effect : world.force_effects) {
-    if (effect->name() == name) return dynamic_cast<SpringDampers*>(effect.get());
+const SpringDampers* find_spring_effect(const World& world, std::string_view name) {
+  for (const auto& effect : world.force_effects) {
+    if (effect->name() == name) return dynamic_cast<const SpringDampers*>(effect.get());
   }
   return nullptr;
+}
+
+SpringDampers* find_spring_effect(World& world, std::string_view name) {
+  return const_cast<SpringDampers*>(find_spring_effect(std::as_const(world), name));
 }
 
 void SpringDampers::add_forces(const Particles& /*p*/, const Matrix3X& x, const Matrix3X& v,

@@ -101,6 +101,7 @@ void spring_forces_of_run(Index count, Index nx, Index nv, const double* __restr
 
 // The spring effect of `world` called `name` ("springs" or "bending"), or nullptr.
 SpringDampers* find_spring_effect(World& world, std::string_view name);
+const SpringDampers* find_spring_effect(const World& world, std::string_view name);
 
 // Appends one spring per pair (a, b), joining particles first + a and first + b, with rest
 // lengths measured in x (the distance at build time). The pairs are added sorted by (b - a, a),

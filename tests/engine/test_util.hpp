@@ -124,13 +124,7 @@ inline clothlab::SpringDampers& spring_effect(clothlab::World& world,
 
 inline const clothlab::SpringDampers& spring_effect(const clothlab::World& world,
                                                     std::string_view name = "springs") {
-  const clothlab::SpringDampers* springs = nullptr;
-  for (const auto& e : world.force_effects) {
-    if (e->name() == name) {
-      springs = dynamic_cast<const clothlab::SpringDampers*>(e.get());
-      break;
-    }
-  }
+  const clothlab::SpringDampers* springs = clothlab::find_spring_effect(world, name);
   REQUIRE(springs != nullptr);
   return *springs;
 }
