@@ -1,8 +1,10 @@
 // Cloth made of spring-dampers (lessons 02-04): the properties the whole engine must keep.
 #include <doctest/doctest.h>
 
+#include <cmath>
 #include <cstring>
 #include <limits>
+#include <random>
 #include <string>
 
 #include "clothlab/aerodynamics.hpp"
@@ -55,7 +57,45 @@ void kick(clothlab::World& world) {
   }
 }
 
+// Exercise 2.1 exactly as lesson 02 writes it: e = e* / l, the two velocities along e, f_sd e.
+Vec3 lecture_spring_damper_force(const Vec3& r1, const Vec3& r2, const Vec3& v1, const Vec3& v2,
+                                 double ks, double kd, double l0) {
+  const Vec3 e_star = r2 - r1;
+  const double l = e_star.norm();
+  if (l == 0.0) return Vec3::Zero();
+  const Vec3 e = e_star / l;
+  const double v1_e = e.dot(v1), v2_e = e.dot(v2);
+  return (-ks * (l0 - l) - kd * (v1_e - v2_e)) * e;
+}
+
 }  // namespace
+
+TEST_CASE("cloth: the reference spring kernel is the lecture's formula, to rounding") {
+  // The reference answer to 2.1 divides once where the lecture's form divides three times, and
+  // takes the damper's dot product with e* (solutions/02_spring_dampers.cpp): the same force,
+  // rounded differently. Over springs of every length, stretch, stiffness and speed, the two
+  // may differ by a few roundings of the largest term, and by no more.
+  std::mt19937 rng(2026);
+  std::uniform_real_distribution<double> unit(-1.0, 1.0), exponent(-3.0, 3.0);
+  const auto vec = [&] { return Vec3(unit(rng), unit(rng), unit(rng)); };
+  const auto magnitude = [&] { return std::pow(10.0, exponent(rng)); };
+  constexpr double eps = std::numeric_limits<double>::epsilon();
+  for (int k = 0; k < 10000; ++k) {
+    const Vec3 r1 = magnitude() * vec(), r2 = r1 + magnitude() * vec();
+    const Vec3 v1 = magnitude() * vec(), v2 = magnitude() * vec();
+    const double ks = magnitude(), kd = magnitude(), l = (r2 - r1).norm();
+    const double l0 = l * (0.5 + 0.5 * (unit(rng) + 1.0));  // from half the length to 1.5 times
+    const Vec3 reference = clothlab::spring_damper_force(r1, r2, v1, v2, ks, kd, l0);
+    const Vec3 lecture = lecture_spring_damper_force(r1, r2, v1, v2, ks, kd, l0);
+    const double scale = ks * (l + l0) + kd * (v1.norm() + v2.norm());
+    CAPTURE(k);
+    CAPTURE(reference.transpose());
+    CAPTURE(lecture.transpose());
+    REQUIRE((reference - lecture).norm() <= 16.0 * eps * scale);
+  }
+  const Vec3 r(0.3, -0.2, 0.1), v(1, 2, 3);
+  CHECK(clothlab::spring_damper_force(r, r, v, -v, 100, 1, 0.2).isZero(0.0));
+}
 
 TEST_CASE("cloth: a grid has the spring counts the lecture's pictures give") {
   // rows x cols particles: structural r(c-1) + c(r-1), shear 2(r-1)(c-1),
