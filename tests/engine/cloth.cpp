@@ -77,12 +77,16 @@ TEST_CASE("cloth: the reference spring kernel is the lecture's formula, to round
   // may differ by a few roundings of the largest term, and by no more.
   std::mt19937 rng(2026);
   std::uniform_real_distribution<double> unit(-1.0, 1.0), exponent(-3.0, 3.0);
-  const auto vec = [&] { return Vec3(unit(rng), unit(rng), unit(rng)); };
+  // The draws are declarations, one after the other, never two arguments of one call (whose
+  // order C++ leaves open): every compiler draws the same springs.
   const auto magnitude = [&] { return std::pow(10.0, exponent(rng)); };
+  const auto vec = [&] {
+    const double size = magnitude(), x = unit(rng), y = unit(rng), z = unit(rng);
+    return Vec3(size * x, size * y, size * z);
+  };
   constexpr double eps = std::numeric_limits<double>::epsilon();
   for (int k = 0; k < 10000; ++k) {
-    const Vec3 r1 = magnitude() * vec(), r2 = r1 + magnitude() * vec();
-    const Vec3 v1 = magnitude() * vec(), v2 = magnitude() * vec();
+    const Vec3 r1 = vec(), r2 = r1 + vec(), v1 = vec(), v2 = vec();
     const double ks = magnitude(), kd = magnitude(), l = (r2 - r1).norm();
     const double l0 = l * (0.5 + 0.5 * (unit(rng) + 1.0));  // from half the length to 1.5 times
     const Vec3 reference = clothlab::spring_damper_force(r1, r2, v1, v2, ks, kd, l0);
