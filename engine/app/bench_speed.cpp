@@ -10,6 +10,9 @@
 //   readable        the same step on the readable path ([engine] fast_path = false)
 //   naive           a lecture-style engine kept here: an array of particle objects, spring
 //                   objects holding pointers to their two particles, ComputeForce() per spring
+//   bare            the engine's force effects and Euler kernel on a state that stays in the fast
+//                   layout, with no copies and no guard: what the reference would cost if the
+//                   engine kept its state that way (1 thread)
 //   kernel          the spring kernel alone (spring_forces_of_run, the fast path's inner loop)
 //                   on 256 springs whose data stay in the first-level cache: the least any step
 //                   built on the spring kernel can cost per spring on this machine
@@ -19,9 +22,9 @@
 //   implicit        implicit Euler on a stiff cloth: the whole step, then its assembly (forces,
 //                   Jacobians, the matrix) and its linear solve
 //
-// All variants but `kernel` and `implicit` compute the same physics; the naive one is checked
-// against the engine after a few steps, and the readable and fast paths agree bit for bit (a
-// test checks it).
+// All variants but `kernel` and `implicit` compute the same physics; the naive and bare ones are
+// checked against the engine after a few steps, and the readable and fast paths agree bit for
+// bit (a test checks it).
 #include <fcntl.h>
 #include <spawn.h>
 #include <sys/wait.h>
@@ -36,6 +39,7 @@
 #include <functional>
 #include <memory>
 #include <sstream>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -46,6 +50,7 @@
 #include "app/build_info.hpp"
 #include "clothlab/cloth.hpp"
 #include "clothlab/euler.hpp"
+#include "clothlab/fast_forces.hpp"
 #include "clothlab/gravity.hpp"
 #include "clothlab/implicit_euler.hpp"
 #include "clothlab/not_implemented.hpp"
@@ -53,6 +58,7 @@
 #include "clothlab/scene.hpp"
 #include "clothlab/spring_damper.hpp"
 #include "clothlab/threads.hpp"
+#include "clothlab/world.hpp"
 
 extern char** environ;
 
@@ -283,6 +289,61 @@ KernelRun kernel_run(const World& world) {
   return run;
 }
 
+// --- The engine's step without its copies and checks ---------------------------------------
+//
+// The reference step copies x and v into the fast layout and f back out (fast_forces.hpp), and
+// the guard checks the state before and after the step. `bare` keeps x, v and f in the fast
+// layout from one step to the next and checks nothing: the world's force effects add their
+// forces through their fast paths (the same code as the reference's), then symplectic Euler's
+// kernel (the scene's integrator) moves each particle right there. What it saves against
+// `reference` is what the copies and the guard cost: about what keeping the engine's state in
+// that layout could gain, short of rewriting the kernels themselves.
+
+struct BareCloth {
+  const World* world = nullptr;
+  FastScratch state;  // x, v and f, rows spaced as on the engine's fast path
+
+  // A copy of the world's state; every force effect must have a fast path.
+  explicit BareCloth(const World& w) : world(&w) {
+    prepare_fast_forces(w, state);
+    if (std::find(state.soa.begin(), state.soa.end(), 0) != state.soa.end()) {
+      throw std::logic_error("bench speed: bare: a force effect has no fast path");
+    }
+    const Index n = w.particles.size();
+    state.resize(n);
+    state.x.leftCols(n) = w.particles.x;
+    state.v.leftCols(n) = w.particles.v;
+  }
+
+  Matrix3X positions() const { return state.x.leftCols(world->particles.size()); }
+  Matrix3X velocities() const { return state.v.leftCols(world->particles.size()); }
+
+  // `flatten`: the exercise kernels inlined here, as in the engine's own loops.
+  [[gnu::flatten, gnu::noinline]] void step(double dt) {
+    const Particles& p = world->particles;
+    const Index n = p.size();
+    state.f.setZero();
+    for (const auto& effect : world->force_effects)
+      effect->add_forces_soa(p, state.x, state.v, state.f, 0, n);
+    const Index nx = state.x.cols(), nv = state.v.cols(), nf = state.f.cols();
+    double* __restrict x = state.x.data();
+    double* __restrict v = state.v.data();
+    const double* __restrict f = state.f.data();
+    const double* __restrict inv_m = p.inv_m.data();
+    for (Index i = 0; i < n; ++i) {
+      const PointState next = symplectic_euler_step(
+          Vec3(x[i], x[nx + i], x[2 * nx + i]), Vec3(v[i], v[nv + i], v[2 * nv + i]),
+          Vec3(f[i], f[nf + i], f[2 * nf + i]), inv_m[i], dt);
+      x[i] = next.r.x();
+      x[nx + i] = next.r.y();
+      x[2 * nx + i] = next.r.z();
+      v[i] = next.v.x();
+      v[nv + i] = next.v.y();
+      v[2 * nv + i] = next.v.z();
+    }
+  }
+};
+
 // --- The variants --------------------------------------------------------------------------
 
 bool wanted(const SpeedOptions& opt, const std::string& variant) {
@@ -342,6 +403,30 @@ void measure_size(int n, int all_cores, const SpeedOptions& opt, std::vector<Mea
                           [&naive, dt] { naive.Step(dt); },
                           {}});
     notes.push_back(fmt::format("agrees with reference to {:.1e} m after 20 steps", gap));
+  }
+  std::unique_ptr<BareCloth> bare;
+  if (wanted(opt, "bare")) {
+    scenes.push_back(std::make_unique<Scene>(parse_scene(cloth_scene(n, 1, true, ""), "<bench>")));
+    Scene& scene = *scenes.back();
+    // The same physics, bit for bit, which the note shows: a copy of the scene, stepped by the
+    // engine, against the bare loop on the same start.
+    Scene check = parse_scene(cloth_scene(n, 1, true, ""), "<bench>");
+    BareCloth bare_check(check.world);
+    for (int k = 0; k < 20; ++k) {
+      bare_check.step(check.dt);
+      check.world.step(check.dt);
+    }
+    const double gap_x = (bare_check.positions() - check.world.particles.x).cwiseAbs().maxCoeff();
+    const double gap_v = (bare_check.velocities() - check.world.particles.v).cwiseAbs().maxCoeff();
+    bare = std::make_unique<BareCloth>(scene.world);
+    const double dt = scene.dt;
+    contenders.push_back(
+        {"bare", 1, spring_count(scene.world), [&bare, dt] { bare->step(dt); }, {}});
+    notes.push_back(gap_x == 0.0 && gap_v == 0.0
+                        ? std::string("the same bits as reference after 20 steps")
+                        : fmt::format("differs from reference after 20 steps: x by {:.1e} m, v "
+                                      "by {:.1e} m/s",
+                                      gap_x, gap_v));
   }
   KernelRun kernel;
   if (wanted(opt, "kernel")) {
@@ -571,11 +656,11 @@ void add_bench_speed_command(CLI::App& bench) {
   speed->add_option("--threads", o.threads, "Threads of the all-cores rows (default: every core)")
       ->check(CLI::Range(1, 1024));
   speed->add_option("--csv", o.csv, "Write one row per measurement to this CSV file");
-  speed
-      ->add_option("--variants", o.variants,
-                   "Variants to measure (default: all): reference, readable, naive, kernel, "
-                   "+aerodynamics, +aerodynamics+ground, implicit, student")
-      ->delimiter(',');
+  // A misspelt variant is an error, not an empty table.
+  speed->add_option("--variants", o.variants, "Variants to measure (default: all)")
+      ->delimiter(',')
+      ->check(CLI::IsMember({"reference", "readable", "naive", "bare", "kernel", "+aerodynamics",
+                             "+aerodynamics+ground", "implicit", "student"}));
   speed->add_flag("--quick", o.quick, "Sizes 16 and 32, one short repeat (for tests)");
   speed->add_flag("--no-student", o.no_student, "Do not run clothlab-student");
   speed->callback([] {

@@ -43,6 +43,12 @@ Index padded(Index n, Index lines) {
 
 }  // namespace
 
+void FastScratch::resize(Index n) {
+  x.resize(3, padded(n, 21));
+  v.resize(3, padded(n, 7));
+  f.resize(3, padded(n, 49));
+}
+
 bool prepare_fast_forces(const World& world, FastScratch& scratch) {
   const auto& effects = world.force_effects;
   scratch.soa.resize(effects.size());
@@ -59,9 +65,7 @@ void fast_forces(const World& world, const Matrix3X& x, const Matrix3X& v, Matri
                  const std::function<void(Index begin, Index end)>* move, StepChecks* checks) {
   const auto& effects = world.force_effects;
   const Index n = x.cols();
-  scratch.x.resize(3, padded(n, 21));
-  scratch.v.resize(3, padded(n, 7));
-  scratch.f.resize(3, padded(n, 49));
+  scratch.resize(n);
   f.resize(3, n);
   std::atomic<bool> start_within = true;
   for_ranges(team, n, [&](Index begin, Index end) {

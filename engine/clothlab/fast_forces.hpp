@@ -34,6 +34,10 @@ class ThreadTeam;
 struct FastScratch {
   SoA3 x, v, f;
   std::vector<char> soa;  // which force effects take the fast path, by their place in the world
+
+  // Room for n particles in x, v and f, each with rows spaced its own way (see fast_forces.cpp):
+  // the columns past n are padding.
+  void resize(Index n);
 };
 
 // The guard's checks of a step (World::step) that a step's one pass takes on, when its

@@ -1,6 +1,6 @@
 # `clothlab bench speed --quick --csv F`: the CSV has the documented header and every row's
-# numbers are positive and finite; the reference and the naive baseline are both there. It never
-# asserts a speed: that would fail on a busy machine.
+# numbers are positive and finite; every variant is there, and the bare loop agrees with the
+# reference bit for bit. It never asserts a speed: that would fail on a busy machine.
 cmake_policy(SET CMP0057 NEW)  # if(... IN_LIST ...)
 file(REMOVE_RECURSE ${WORK})
 file(MAKE_DIRECTORY ${WORK})
@@ -35,9 +35,21 @@ foreach(line ${lines})
     endif()
   endforeach()
 endforeach()
-foreach(variant reference readable naive kernel +aerodynamics +aerodynamics+ground implicit)
+foreach(variant reference readable naive bare kernel +aerodynamics +aerodynamics+ground implicit)
   if(NOT variant IN_LIST variants)
     message(FATAL_ERROR "no '${variant}' row in speed.csv:\n${out}")
+  endif()
+endforeach()
+# The bare loop (the engine's kernels on a state kept in the fast layout, no copies, no guard)
+# computes the reference's physics bit for bit, at both sizes.
+string(REGEX MATCHALL "bare +1 +[^\n]*" bare_rows "${out}")
+list(LENGTH bare_rows bare_count)
+if(NOT bare_count EQUAL 2)
+  message(FATAL_ERROR "expected a bare row per size, found ${bare_count}:\n${out}")
+endif()
+foreach(row ${bare_rows})
+  if(NOT row MATCHES "the same bits as reference after 20 steps")
+    message(FATAL_ERROR "the bare loop does not compute the reference's physics:\n  ${row}")
   endif()
 endforeach()
 # The shipped stubs cannot run the scene: the student row is skipped, naming the exercise.
