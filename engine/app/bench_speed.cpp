@@ -12,7 +12,7 @@
 //                   objects holding pointers to their two particles, ComputeForce() per spring
 //   bare            the engine's force effects and Euler kernel on a state that stays in the fast
 //                   layout, with no copies and no guard: what the reference would cost if the
-//                   engine kept its state that way (1 thread)
+//                   engine kept its state that way (1 thread and every core)
 //   kernel          the spring kernel alone (spring_forces_of_run, the fast path's inner loop)
 //                   on 256 springs whose data stay in the first-level cache: the least any step
 //                   built on the spring kernel can cost per spring on this machine
@@ -303,44 +303,65 @@ KernelRun kernel_run(const World& world) {
 struct BareCloth {
   const World* world = nullptr;
   FastScratch state;  // x, v and f, rows spaced as on the engine's fast path
+  FastScratch next;   // with threads, x and v after the step: a thread moves its particles here
+                      // while the others may still read their x and v in `state`
+  std::unique_ptr<ThreadTeam> team;  // null on 1 thread
 
   // A copy of the world's state; every force effect must have a fast path.
-  explicit BareCloth(const World& w) : world(&w) {
+  BareCloth(const World& w, int threads) : world(&w) {
     prepare_fast_forces(w, state);
     if (std::find(state.soa.begin(), state.soa.end(), 0) != state.soa.end()) {
       throw std::logic_error("bench speed: bare: a force effect has no fast path");
     }
     const Index n = w.particles.size();
     state.resize(n);
+    if (threads > 1) next.resize(n);
     state.x.leftCols(n) = w.particles.x;
     state.v.leftCols(n) = w.particles.v;
+    if (threads > 1) team = std::make_unique<ThreadTeam>(threads);
   }
 
   Matrix3X positions() const { return state.x.leftCols(world->particles.size()); }
   Matrix3X velocities() const { return state.v.leftCols(world->particles.size()); }
 
+  // As on the engine's fast path, each thread owns a contiguous range of particles: it sums
+  // their forces, then moves them, into `next` while the others may still read their x and v.
+  // On one thread they move in place.
+  void step(double dt) {
+    if (!team) {
+      step_range(0, world->particles.size(), dt, state.x.data(), state.v.data());
+      return;
+    }
+    for_ranges(team.get(), world->particles.size(), [&](Index begin, Index end) {
+      step_range(begin, end, dt, next.x.data(), next.v.data());
+    });
+    state.x.swap(next.x);
+    state.v.swap(next.v);
+  }
+
   // `flatten`: the exercise kernels inlined here, as in the engine's own loops.
-  [[gnu::flatten, gnu::noinline]] void step(double dt) {
+  // x_out and v_out have the rows of state.x and state.v, and may be theirs.
+  [[gnu::flatten, gnu::noinline]] void step_range(Index begin, Index end, double dt, double* x_out,
+                                                  double* v_out) {
     const Particles& p = world->particles;
-    const Index n = p.size();
-    state.f.setZero();
+    state.f.middleCols(begin, end - begin).setZero();
     for (const auto& effect : world->force_effects)
-      effect->add_forces_soa(p, state.x, state.v, state.f, 0, n);
+      effect->add_forces_soa(p, state.x, state.v, state.f, begin, end);
     const Index nx = state.x.cols(), nv = state.v.cols(), nf = state.f.cols();
-    double* __restrict x = state.x.data();
-    double* __restrict v = state.v.data();
-    const double* __restrict f = state.f.data();
-    const double* __restrict inv_m = p.inv_m.data();
-    for (Index i = 0; i < n; ++i) {
-      const PointState next = symplectic_euler_step(
+    const double* x = state.x.data();
+    const double* v = state.v.data();
+    const double* f = state.f.data();
+    const double* inv_m = p.inv_m.data();
+    for (Index i = begin; i < end; ++i) {
+      const PointState moved = symplectic_euler_step(
           Vec3(x[i], x[nx + i], x[2 * nx + i]), Vec3(v[i], v[nv + i], v[2 * nv + i]),
           Vec3(f[i], f[nf + i], f[2 * nf + i]), inv_m[i], dt);
-      x[i] = next.r.x();
-      x[nx + i] = next.r.y();
-      x[2 * nx + i] = next.r.z();
-      v[i] = next.v.x();
-      v[nv + i] = next.v.y();
-      v[2 * nv + i] = next.v.z();
+      x_out[i] = moved.r.x();
+      x_out[nx + i] = moved.r.y();
+      x_out[2 * nx + i] = moved.r.z();
+      v_out[i] = moved.v.x();
+      v_out[nv + i] = moved.v.y();
+      v_out[2 * nv + i] = moved.v.z();
     }
   }
 };
@@ -405,29 +426,34 @@ void measure_size(int n, int all_cores, const SpeedOptions& opt, std::vector<Mea
                           {}});
     notes.push_back(fmt::format("agrees with reference to {:.1e} m after 20 steps", gap));
   }
-  std::unique_ptr<BareCloth> bare;
+  std::vector<std::unique_ptr<BareCloth>> bares;
   if (wanted(opt, "bare")) {
-    scenes.push_back(std::make_unique<Scene>(parse_scene(cloth_scene(n, 1, true, ""), "<bench>")));
-    Scene& scene = *scenes.back();
-    // The same physics, bit for bit, which the note shows: a copy of the scene, stepped by the
-    // engine, against the bare loop on the same start.
-    Scene check = parse_scene(cloth_scene(n, 1, true, ""), "<bench>");
-    BareCloth bare_check(check.world);
-    for (int k = 0; k < 20; ++k) {
-      bare_check.step(check.dt);
-      check.world.step(check.dt);
+    for (int threads : thread_counts) {
+      scenes.push_back(
+          std::make_unique<Scene>(parse_scene(cloth_scene(n, 1, true, ""), "<bench>")));
+      Scene& scene = *scenes.back();
+      // The same physics, bit for bit, which the note shows: a copy of the scene, stepped by
+      // the engine, against the bare loop on the same start.
+      Scene check = parse_scene(cloth_scene(n, 1, true, ""), "<bench>");
+      BareCloth bare_check(check.world, threads);
+      for (int k = 0; k < 20; ++k) {
+        bare_check.step(check.dt);
+        check.world.step(check.dt);
+      }
+      const double gap_x = (bare_check.positions() - check.world.particles.x).cwiseAbs().maxCoeff();
+      const double gap_v =
+          (bare_check.velocities() - check.world.particles.v).cwiseAbs().maxCoeff();
+      bares.push_back(std::make_unique<BareCloth>(scene.world, threads));
+      BareCloth& bare = *bares.back();
+      const double dt = scene.dt;
+      contenders.push_back(
+          {"bare", threads, spring_count(scene.world), [&bare, dt] { bare.step(dt); }, {}});
+      notes.push_back(gap_x == 0.0 && gap_v == 0.0
+                          ? std::string("the same bits as reference after 20 steps")
+                          : fmt::format("differs from reference after 20 steps: x by {:.1e} m, "
+                                        "v by {:.1e} m/s",
+                                        gap_x, gap_v));
     }
-    const double gap_x = (bare_check.positions() - check.world.particles.x).cwiseAbs().maxCoeff();
-    const double gap_v = (bare_check.velocities() - check.world.particles.v).cwiseAbs().maxCoeff();
-    bare = std::make_unique<BareCloth>(scene.world);
-    const double dt = scene.dt;
-    contenders.push_back(
-        {"bare", 1, spring_count(scene.world), [&bare, dt] { bare->step(dt); }, {}});
-    notes.push_back(gap_x == 0.0 && gap_v == 0.0
-                        ? std::string("the same bits as reference after 20 steps")
-                        : fmt::format("differs from reference after 20 steps: x by {:.1e} m, v "
-                                      "by {:.1e} m/s",
-                                      gap_x, gap_v));
   }
   KernelRun kernel;
   if (wanted(opt, "kernel")) {

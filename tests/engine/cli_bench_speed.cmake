@@ -41,11 +41,13 @@ foreach(variant reference readable naive bare kernel +aerodynamics +aerodynamics
   endif()
 endforeach()
 # The bare loop (the engine's kernels on a state kept in the fast layout, no copies, no guard)
-# computes the reference's physics bit for bit, at both sizes.
-string(REGEX MATCHALL "bare +1 +[^\n]*" bare_rows "${out}")
+# computes the reference's physics bit for bit, at both sizes, on 1 thread and on every core.
+string(REGEX MATCHALL "  bare +[0-9]+ +[^\n]*" bare_rows "${out}")
+string(REGEX MATCHALL "  bare +1 +" bare_rows_1 "${out}")
 list(LENGTH bare_rows bare_count)
-if(NOT bare_count EQUAL 2)
-  message(FATAL_ERROR "expected a bare row per size, found ${bare_count}:\n${out}")
+list(LENGTH bare_rows_1 bare_count_1)
+if(NOT bare_count_1 EQUAL 2 OR bare_count LESS 2)
+  message(FATAL_ERROR "expected a 1-thread bare row per size, found ${bare_count_1}:\n${out}")
 endif()
 foreach(row ${bare_rows})
   if(NOT row MATCHES "the same bits as reference after 20 steps")
