@@ -109,6 +109,16 @@ class PostStepEffect {
   // whole world: some post-step effects change more than particles (tearing removes springs
   // and triangles).
   virtual void apply(World& world, double dt) = 0;
+
+  // Whether apply changes each particle from that particle's own position, velocity and mass
+  // alone, and nothing else (a ground, a sphere). A step whose integrator moves every particle
+  // in one pass then applies the effect in that pass, range by range, right after moving each
+  // range (apply_range), while those particles are still in the cache, instead of in a pass of
+  // its own over the whole state (World::step).
+  virtual bool acts_per_particle() const { return false; }
+  // apply on particles [begin, end) only, for an effect that acts_per_particle. Threads may call
+  // it on different ranges at once.
+  virtual void apply_range(Particles& /*p*/, double /*dt*/, Index /*begin*/, Index /*end*/) const {}
 };
 
 }  // namespace clothlab

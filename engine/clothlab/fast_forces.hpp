@@ -43,11 +43,14 @@ struct FastScratch {
 // The guard's checks of a step (World::step) that a step's one pass takes on, when its
 // integrator moves every particle in that pass (Integrator::moves_in_one_pass): each particle is
 // checked while the pass has it in the cache, instead of in passes of their own over the state.
+// The post-step effects that act on each particle alone and lead the world's list (a ground, a
+// sphere) ride along too: after_move applies them to each range right after it moves.
 struct StepChecks {
   bool armed = false;        // World::step sets it; the step's compute_forces_then clears it
-  bool end = false;          // check the state after the move too (no post-step effect follows)
+  bool end = false;          // check the state after the move too (no other post-step effect)
   bool end_checked = false;  // the pass checked every particle after moving it,
   bool end_within = false;   // and found them all within the guard's bounds
+  const std::function<void(Index begin, Index end)>* after_move = nullptr;
 };
 
 // Asks every force effect whether it has a fast path (once per evaluation, on one thread: an

@@ -45,6 +45,8 @@ class Ground final : public PostStepEffect {
       : y0_(y0), material_(material), model_(model), friction_(friction) {}
   std::string_view name() const override { return "ground"; }
   void apply(World& world, double dt) override;
+  bool acts_per_particle() const override { return true; }
+  void apply_range(Particles& p, double dt, Index begin, Index end) const override;
   double y0() const { return y0_; }
 
  private:
@@ -61,6 +63,8 @@ class Sphere final : public PostStepEffect {
       : centre_(centre), radius_(radius), material_(material) {}
   std::string_view name() const override { return "sphere"; }
   void apply(World& world, double dt) override;
+  bool acts_per_particle() const override { return true; }
+  void apply_range(Particles& p, double dt, Index begin, Index end) const override;
   const Vec3& centre() const { return centre_; }
   double radius() const { return radius_; }
 

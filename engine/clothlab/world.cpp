@@ -24,18 +24,30 @@ void World::step(double dt) {
     // a NaN can spread. An integrator that moves every particle in one pass has that pass check
     // each particle before anything moves, and after moving it when nothing else follows
     // (StepChecks): the same checks, without two more passes over the whole state.
+    // The post-step effects that act on each particle alone, from the front of the list, go
+    // into that pass as well: each range of particles meets them right after it moves, in the
+    // order of the list, as it would in passes of their own. The others follow the step.
     step_checks_ = StepChecks{};
+    size_t in_pass = 0;
+    const std::function<void(Index, Index)> after_move = [&](Index begin, Index end) {
+      for (size_t k = 0; k < in_pass; ++k)
+        post_step_effects[k]->apply_range(particles, dt, begin, end);
+    };
     if (integrator->moves_in_one_pass()) {
+      while (in_pass < post_step_effects.size() && post_step_effects[in_pass]->acts_per_particle())
+        ++in_pass;
       step_checks_.armed = true;
-      step_checks_.end = post_step_effects.empty();
+      step_checks_.end = in_pass == post_step_effects.size();
+      if (in_pass > 0) step_checks_.after_move = &after_move;
     } else {
       guard.check(*this, /*before_step=*/true);
     }
     integrator->advance(*this, dt);  // calls compute_forces (steps 1-2) as often as it needs
     assert(!step_checks_.armed &&
            "moves_in_one_pass, but advance did not call compute_forces_then");
-    for (const auto& effect : post_step_effects)
-      effect->apply(*this, dt);
+    step_checks_.after_move = nullptr;
+    for (size_t k = in_pass; k < post_step_effects.size(); ++k)
+      post_step_effects[k]->apply(*this, dt);
     t += dt;
     ++steps;
     if (!(step_checks_.end_checked && step_checks_.end_within)) guard.check(*this);
@@ -90,15 +102,26 @@ void World::compute_forces_then(const Matrix3X& x, const Matrix3X& v, Matrix3X& 
   const bool step_pass = std::exchange(step_checks_.armed, false);
   assert((!step_pass || (&x == &particles.x && &v == &particles.v)) &&
          "compute_forces_then of a step moves the particles' own state");
+  // The step's post-step effects that ride along (StepChecks::after_move): each range meets
+  // them right after it moves.
+  std::function<void(Index, Index)> move_then_after;
+  const std::function<void(Index, Index)>* moves = &move;
+  if (step_pass && step_checks_.after_move) {
+    move_then_after = [&](Index begin, Index end) {
+      move(begin, end);
+      (*step_checks_.after_move)(begin, end);
+    };
+    moves = &move_then_after;
+  }
   if (!takes_fast_path() || !prepare_fast_forces(*this, fast_)) {
     if (step_pass) guard.check(*this, /*before_step=*/true);
     compute_forces_readable(x, v, f);
-    for_particles(move);
+    for_particles(*moves);
     return;
   }
   ++force_evaluations;
   ++fast_evaluations;
-  fast_forces(*this, x, v, f, fast_, team(), &move, step_pass ? &step_checks_ : nullptr);
+  fast_forces(*this, x, v, f, fast_, team(), moves, step_pass ? &step_checks_ : nullptr);
 }
 
 void World::for_particles(const std::function<void(Index begin, Index end)>& range) const {

@@ -6,6 +6,9 @@
 //   3. the integrator advances positions and velocities (re-evaluating 1-2 if it needs to);
 //   4. every post-step effect applies (collisions, plasticity, tearing);
 //   5. the guard checks that the state is still finite and bounded.
+// An integrator that moves every particle in one pass (the Euler methods) does steps 1-3 in that
+// pass, and takes along the guard's checks and the post-step effects that act on each particle
+// alone (a ground, a sphere): each particle meets them right after it moves (World::step).
 #pragma once
 
 #include <functional>

@@ -409,6 +409,134 @@ TEST_CASE("fast path: springs listed from their higher-numbered end match the re
   CHECK(identical(fast.world.particles.v, readable.world.particles.v));
 }
 
+namespace {
+
+// The scene stepped `steps` times the way `clothlab run --stats` steps it: every post-step
+// effect in a pass of its own after the integrator, the guard's checks in passes of their own.
+clothlab::Scene run_in_separate_passes(const std::string& text, int steps,
+                                       const std::function<void(clothlab::World&)>& edit = {}) {
+  clothlab::Scene scene = clothlab::parse_scene(text, "fast-path.toml");
+  if (edit) edit(scene.world);
+  clothlab::StepTimes times;
+  scene.world.timing = &times;
+  for (int s = 0; s < steps; ++s)
+    scene.world.step(scene.dt);
+  return scene;
+}
+
+// A post-step effect that acts on each particle alone (a small push along x for any particle
+// below y = -0.3) and counts how the step calls it.
+class PushLowParticles final : public clothlab::PostStepEffect {
+ public:
+  mutable std::atomic<long> ranges{0}, wholes{0};
+  std::string_view name() const override { return "push"; }
+  void apply(clothlab::World& world, double dt) override {
+    ++wholes;
+    apply_one(world.particles, dt, 0, world.particles.size());
+  }
+  bool acts_per_particle() const override { return true; }
+  void apply_range(clothlab::Particles& p, double dt, Index begin, Index end) const override {
+    ++ranges;
+    apply_one(p, dt, begin, end);
+  }
+
+ private:
+  static void apply_one(clothlab::Particles& p, double dt, Index begin, Index end) {
+    for (Index i = begin; i < end; ++i)
+      if (p.x(1, i) < -0.3 && p.inv_m[i] > 0.0) p.v(0, i) += 0.5 * dt;
+  }
+};
+
+// A post-step effect that reads the whole state: the lowest height of any particle, each step.
+class RecordLowest final : public clothlab::PostStepEffect {
+ public:
+  std::vector<double> lowest;
+  std::string_view name() const override { return "record"; }
+  void apply(clothlab::World& world, double /*dt*/) override {
+    lowest.push_back(world.particles.x.row(1).minCoeff());
+  }
+};
+
+}  // namespace
+
+TEST_CASE(
+    "fast path: a ground and a sphere in the step's one pass give the state of passes "
+    "of their own") {
+  // The cloth hangs from y = 0 to y = -0.88: its lower rows start below the ground (y = -0.6)
+  // and some particles inside the sphere, so both push particles out from the first step.
+  const std::string sphere = "[sphere]\ncentre = [0.4, -0.45, 0.0]\nradius = 0.08\n";
+  const auto no_buoyancy = [](clothlab::World& w) {
+    std::erase_if(w.force_effects, [](const auto& e) { return e->name() == "buoyancy"; });
+  };
+  // With buoyancy last (no fast path) the particles move after the forces' pass, without it in
+  // that pass; the Euler methods move in one pass either way, RK4 does not.
+  for (const char* method : {"symplectic-euler", "explicit-euler", "rk4"}) {
+    for (bool buoyancy : {true, false}) {
+      const std::string text = cloth(sphere, method);
+      const auto edit = buoyancy ? std::function<void(clothlab::World&)>{} : no_buoyancy;
+      const clothlab::Scene separate = run_in_separate_passes(text, 30, edit);
+      const clothlab::World& want = separate.world;
+      REQUIRE(want.post_step_effects.size() == 2);
+      CHECK(want.particles.x.row(1).minCoeff() == -0.6);  // particles lie on the ground
+      const clothlab::Vec3 centre(0.4, -0.45, 0.0);
+      const double nearest = (want.particles.x.colwise() - centre).colwise().norm().minCoeff();
+      CHECK(nearest == doctest::Approx(0.08).epsilon(1e-9));  // and on the sphere
+      for (bool fast : {true, false}) {
+        for (int threads : {1, 2, 3}) {
+          CAPTURE(method);
+          CAPTURE(buoyancy);
+          CAPTURE(fast);
+          CAPTURE(threads);
+          const clothlab::Scene one_pass = run(text, fast, threads, 30, edit);
+          CHECK(identical(one_pass.world.particles.x, want.particles.x));
+          CHECK(identical(one_pass.world.particles.v, want.particles.v));
+        }
+      }
+    }
+  }
+}
+
+TEST_CASE(
+    "fast path: only the post-step effects that act per particle and lead the list go "
+    "into the step's pass") {
+  // Per-particle effects at the front of the list are applied range by range in the pass
+  // (apply_range), never in a pass of their own (apply).
+  const std::string text = cloth("");
+  for (int threads : {1, 2}) {
+    CAPTURE(threads);
+    PushLowParticles* push = nullptr;
+    const auto push_first = [&](clothlab::World& w) {
+      auto effect = std::make_unique<PushLowParticles>();
+      push = effect.get();
+      w.post_step_effects.insert(w.post_step_effects.begin(), std::move(effect));
+    };
+    const clothlab::Scene one_pass = run(text, true, threads, 40, push_first);
+    CHECK(push->wholes == 0);
+    CHECK(push->ranges >= 40);
+    const clothlab::Scene separate = run_in_separate_passes(text, 40, push_first);
+    CHECK(push->wholes == 40);
+    CHECK(push->ranges == 0);
+    CHECK(identical(one_pass.world.particles.x, separate.world.particles.x));
+    CHECK(identical(one_pass.world.particles.v, separate.world.particles.v));
+  }
+  // Behind an effect that reads the whole state, the ground waits until the step has moved
+  // every particle and that effect has seen them: the lowest heights it records come from
+  // before the ground lifts anything, as in passes of their own.
+  RecordLowest* record = nullptr;
+  const auto record_first = [&](clothlab::World& w) {
+    auto effect = std::make_unique<RecordLowest>();
+    record = effect.get();
+    w.post_step_effects.insert(w.post_step_effects.begin(), std::move(effect));
+  };
+  const clothlab::Scene separate = run_in_separate_passes(text, 40, record_first);
+  const std::vector<double> want = record->lowest;
+  REQUIRE(want.size() == 40);
+  CHECK(want.front() < -0.6);  // below the ground when recorded
+  const clothlab::Scene one_pass = run(text, true, 2, 40, record_first);
+  CHECK(record->lowest == want);
+  CHECK(identical(one_pass.world.particles.x, separate.world.particles.x));
+}
+
 TEST_CASE("fast path: a thread team runs every job once and passes on what a job throws") {
   clothlab::ThreadTeam team(3);
   std::atomic<int> sum{0};
