@@ -50,6 +50,10 @@ struct StepChecks {
   bool end = false;          // check the state after the move too (no other post-step effect)
   bool end_checked = false;  // the pass checked every particle after moving it,
   bool end_within = false;   // and found them all within the guard's bounds
+  // The post-step effects that ride along: the first post_in_pass of the world's list, applied
+  // by after_move to each range right after it moves, for a step of dt [s].
+  size_t post_in_pass = 0;
+  double dt = 0.0;
   const std::function<void(Index begin, Index end)>* after_move = nullptr;
 };
 

@@ -29,15 +29,18 @@ void World::step(double dt) {
     // order of the list, as it would in passes of their own. The others follow the step.
     step_checks_ = StepChecks{};
     size_t in_pass = 0;
-    const std::function<void(Index, Index)> after_move = [&](Index begin, Index end) {
-      for (size_t k = 0; k < in_pass; ++k)
-        post_step_effects[k]->apply_range(particles, dt, begin, end);
+    // It captures `this` alone, so that std::function keeps it without allocating.
+    const std::function<void(Index, Index)> after_move = [this](Index begin, Index end) {
+      for (size_t k = 0; k < step_checks_.post_in_pass; ++k)
+        post_step_effects[k]->apply_range(particles, step_checks_.dt, begin, end);
     };
     if (integrator->moves_in_one_pass()) {
       while (in_pass < post_step_effects.size() && post_step_effects[in_pass]->acts_per_particle())
         ++in_pass;
       step_checks_.armed = true;
       step_checks_.end = in_pass == post_step_effects.size();
+      step_checks_.post_in_pass = in_pass;
+      step_checks_.dt = dt;
       if (in_pass > 0) step_checks_.after_move = &after_move;
     } else {
       guard.check(*this, /*before_step=*/true);
