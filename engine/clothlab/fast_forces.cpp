@@ -61,8 +61,8 @@ bool prepare_fast_forces(const World& world, FastScratch& scratch) {
 }
 
 void fast_forces(const World& world, const Matrix3X& x, const Matrix3X& v, Matrix3X& f,
-                 FastScratch& scratch, ThreadTeam* team,
-                 const std::function<void(Index begin, Index end)>* move, StepChecks* checks) {
+                 FastScratch& scratch, ThreadTeam* team, const MoveRange* move,
+                 StepChecks* checks) {
   const auto& effects = world.force_effects;
   const Index n = x.cols();
   scratch.resize(n);
@@ -110,17 +110,27 @@ void fast_forces(const World& world, const Matrix3X& x, const Matrix3X& v, Matri
     const bool check_end = move_here && checks && checks->end;
     std::atomic<bool> end_within = true;
     for_ranges(team, n, [&](Index begin, Index end) {
-      for (size_t k = e; k < last; ++k)
-        effects[k]->add_forces_soa(world.particles, scratch.x, scratch.v, scratch.f, begin, end);
-      if (!move_here) return;
-      // These particles' forces are final: no other thread adds to them. The others read x and
-      // v from the copies, so moving these in x and v changes nothing they see.
+      if (!move_here) {
+        for (size_t k = e; k < last; ++k)
+          effects[k]->add_forces_soa(world.particles, scratch.x, scratch.v, scratch.f, begin, end);
+        return;
+      }
+      // Block by block (World::pass_block): every effect adds its forces on the block, then the
+      // block moves, while its x, v and f are still in the cache. These particles' forces are
+      // final: no other block or thread adds to them. The others read x and v from the copies,
+      // so moving these in x and v changes nothing they see.
       const Particles& p = world.particles;
-      for (Index c0 = begin; c0 < end; c0 += kPassChunk) {
-        const Index c1 = std::min(c0 + kPassChunk, end);
-        from_soa(c0, c1, scratch.f.data(), scratch.f.cols(), f.data());
-        (*move)(c0, c1);
-        if (check_end && !world.guard.within(p.x, p.v, c0, c1)) end_within = false;
+      const Index block = std::max<Index>(world.pass_block, 1);
+      for (Index b0 = begin; b0 < end; b0 += block) {
+        const Index b1 = std::min(b0 + block, end);
+        for (size_t k = e; k < last; ++k)
+          effects[k]->add_forces_soa(p, scratch.x, scratch.v, scratch.f, b0, b1);
+        for (Index c0 = b0; c0 < b1; c0 += kPassChunk) {
+          const Index c1 = std::min(c0 + kPassChunk, b1);
+          from_soa(c0, c1, scratch.f.data(), scratch.f.cols(), f.data());
+          (*move)(c0, c1, &scratch);
+          if (check_end && !world.guard.within(p.x, p.v, c0, c1)) end_within = false;
+        }
       }
     });
     if (check_end) {
@@ -131,7 +141,7 @@ void fast_forces(const World& world, const Matrix3X& x, const Matrix3X& v, Matri
     e = last;
   }
   if (in_soa) move_f(false);
-  if (move) for_ranges(team, n, *move);
+  if (move) for_ranges(team, n, [&](Index begin, Index end) { (*move)(begin, end, nullptr); });
 }
 
 }  // namespace clothlab

@@ -100,18 +100,18 @@ void World::compute_forces(const Matrix3X& x, const Matrix3X& v, Matrix3X& f) co
 }
 
 void World::compute_forces_then(const Matrix3X& x, const Matrix3X& v, Matrix3X& f,
-                                const std::function<void(Index begin, Index end)>& move) const {
+                                const MoveRange& move) const {
   // The step's own pass (World::step armed its checks): (x, v) is the state it starts from.
   const bool step_pass = std::exchange(step_checks_.armed, false);
   assert((!step_pass || (&x == &particles.x && &v == &particles.v)) &&
          "compute_forces_then of a step moves the particles' own state");
   // The step's post-step effects that ride along (StepChecks::after_move): each range meets
   // them right after it moves.
-  std::function<void(Index, Index)> move_then_after;
-  const std::function<void(Index, Index)>* moves = &move;
+  MoveRange move_then_after;
+  const MoveRange* moves = &move;
   if (step_pass && step_checks_.after_move) {
-    move_then_after = [&](Index begin, Index end) {
-      move(begin, end);
+    move_then_after = [&](Index begin, Index end, const FastScratch* copies) {
+      move(begin, end, copies);
       (*step_checks_.after_move)(begin, end);
     };
     moves = &move_then_after;
@@ -119,7 +119,7 @@ void World::compute_forces_then(const Matrix3X& x, const Matrix3X& v, Matrix3X& 
   if (!takes_fast_path() || !prepare_fast_forces(*this, fast_)) {
     if (step_pass) guard.check(*this, /*before_step=*/true);
     compute_forces_readable(x, v, f);
-    for_particles(*moves);
+    for_particles([&](Index begin, Index end) { (*moves)(begin, end, nullptr); });
     return;
   }
   ++force_evaluations;

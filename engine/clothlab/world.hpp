@@ -58,6 +58,9 @@ class World {
   // How the engine runs ([engine] in a scene, `clothlab run --threads N`).
   int threads = 1;        // threads a step may use (fast path, Euler, guard); 1: this one only
   bool fast_path = true;  // false: every force evaluation takes the readable path
+  // Particles a thread sums and moves at once in a step's one pass (kPassBlock). Any value
+  // gives the same bits; it sets only how much of the cloth each pass keeps in the cache.
+  Index pass_block = kPassBlock;
 
   // Takes one step of dt [s] (steps 1-5 above).
   void step(double dt);
@@ -70,11 +73,12 @@ class World {
   // compute_forces, then move(begin, end) on contiguous ranges of particles that cover them all
   // once, as for_particles does: an integrator's update, which may read f and change the state
   // of particles [begin, end) only. On the fast path each thread moves its own particles as soon
-  // as their forces are summed, a few hundred at a time, in the same pass over them, and the
-  // guard can check each particle there (World::step). So with threads, if an effect throws
-  // (an exercise not done yet), the particles of the other threads may have moved already.
+  // as their forces are summed, a block at a time (pass_block), in the same pass over them, and
+  // the guard can check each particle there (World::step); the move may read x, v and f from the
+  // fast path's copies (MoveRange). So if an effect throws (an exercise not done yet), the
+  // particles of earlier blocks, or of other threads, may have moved already.
   void compute_forces_then(const Matrix3X& x, const Matrix3X& v, Matrix3X& f,
-                           const std::function<void(Index begin, Index end)>& move) const;
+                           const MoveRange& move) const;
 
   // The lecture's loop, the one the lessons show: clear f, then each effect adds its forces.
   void compute_forces_readable(const Matrix3X& x, const Matrix3X& v, Matrix3X& f) const;

@@ -235,6 +235,34 @@ TEST_CASE("fast path: the Euler methods move particles in the pass that sums the
   }
 }
 
+TEST_CASE("fast path: blocks of any size give the readable state bit for bit") {
+  // A step's one pass takes each thread's particles pass_block at a time through every effect,
+  // then moves them (fast_forces.cpp): springs across a block's border are evaluated on both
+  // sides. Blocks of one particle, shorter than a row, ending mid-row and mid-chunk, and larger
+  // than the cloth; with a ground and a sphere riding along (the cloth starts through both).
+  const std::string text = cloth("[sphere]\ncentre = [0.4, -0.45, 0.0]\nradius = 0.08\n");
+  const auto no_buoyancy = [](clothlab::World& w) {
+    std::erase_if(w.force_effects, [](const auto& e) { return e->name() == "buoyancy"; });
+  };
+  const clothlab::Scene readable = run(text, false, 1, 40, no_buoyancy);
+  CHECK(readable.world.particles.x.row(1).minCoeff() == -0.6);  // particles lie on the ground
+  for (const Index block : {Index{1}, Index{29}, Index{600}, Index{1000}, Index{100000}}) {
+    for (int threads : {1, 2}) {
+      CAPTURE(block);
+      CAPTURE(threads);
+      const clothlab::Scene fast = run(text, true, threads, 40, [&](clothlab::World& w) {
+        no_buoyancy(w);
+        w.pass_block = block;
+      });
+      REQUIRE(fast.world.force_effects.back()->adds_soa(fast.world.particles));
+      CHECK(fast.world.fast_evaluations == fast.world.force_evaluations);
+      CHECK(identical(fast.world.particles.x, readable.world.particles.x));
+      CHECK(identical(fast.world.particles.v, readable.world.particles.v));
+      CHECK(identical(fast.world.particles.f, readable.world.particles.f));
+    }
+  }
+}
+
 TEST_CASE("fast path: 2, 3 and 4 threads give the 1-thread state bit for bit") {
   const std::string text = cloth("");
   const clothlab::Scene one = run(text, true, 1, 150);
