@@ -35,8 +35,10 @@ void SpringSet::erase(const std::vector<size_t>& positions) {
     l_built[kept] = l_built[k];
     ++kept;
   }
-  for (auto* column : {&ks, &kd, &l0, &l_built})
-    column->resize(kept);
+  ks.resize(kept);
+  kd.resize(kept);
+  l0.resize(kept);
+  l_built.resize(kept);
   i.resize(kept);
   j.resize(kept);
   changed();
@@ -56,11 +58,12 @@ std::vector<SpringRun> spring_runs(const SpringSet& s) {
     if (!runs.empty()) {
       SpringRun& last = runs.back();
       if (s.i[k] == last.i0 + last.length && s.j[k] == last.j0 + last.length) {
+        last.uniform = last.uniform && s.ks[k] == s.ks[last.k0] && s.kd[k] == s.kd[last.k0];
         ++last.length;
         continue;
       }
     }
-    runs.push_back({k, s.i[k], s.j[k], 1});
+    runs.push_back({k, s.i[k], s.j[k], 1, true});
   }
   return runs;
 }
@@ -108,7 +111,10 @@ void SpringDampers::add_forces(const Particles& /*p*/, const Matrix3X& x, const 
 // same kernel, but run by run (see SpringRun): along a run both ends move one particle at a
 // time, and in the structure-of-arrays layout every input of spring t + 1 sits just after that
 // of spring t. The compiler then evaluates the kernel (inlined at link time) on four springs at
-// once. A run is taken in chunks of kChunk springs:
+// once (eight with AVX-512). A uniform run (SpringRun::uniform, a family added with one ks and
+// one kd) passes its first spring's ks and kd to every spring, so each spring reads one constant
+// from memory instead of three (engine/SPEED.md measures what that saves on a large cloth). A run
+// is taken in chunks of kChunk springs:
 //
 //   1. f1 of the chunk's springs into a small buffer (it stays in the processor's nearest cache);
 //   2. the chunk's upper ends (the higher particle numbers) take their shares, then its lower
@@ -127,22 +133,36 @@ void SpringDampers::add_forces(const Particles& /*p*/, const Matrix3X& x, const 
 // takes every spring with an end in its range. A spring between two ranges is computed by both
 // threads (the same bits twice); nothing is shared, so there are no locks and no atomics.
 
+namespace {
+
 // A function of its own, not inlined, so that every pointer can be declared not to overlap the
-// others: then the compiler vectorises the loop, kernel inlined.
-[[gnu::noinline]] void spring_forces_of_run(
-    Index count, Index nx, Index nv, const double* __restrict x1, const double* __restrict x2,
-    const double* __restrict v1, const double* __restrict v2, const double* __restrict ks,
-    const double* __restrict kd, const double* __restrict l0, double* __restrict f1x,
-    double* __restrict f1y, double* __restrict f1z) {
+// others: then the compiler vectorises the loop, kernel inlined. With Uniform, ks[0] and kd[0]
+// serve every spring: read once, outside the loop, instead of two more numbers per spring.
+template <bool Uniform>
+[[gnu::noinline]] void forces_of_run(Index count, Index nx, Index nv, const double* __restrict x1,
+                                     const double* __restrict x2, const double* __restrict v1,
+                                     const double* __restrict v2, const double* __restrict ks,
+                                     const double* __restrict kd, const double* __restrict l0,
+                                     double* __restrict f1x, double* __restrict f1y,
+                                     double* __restrict f1z) {
   for (Index t = 0; t < count; ++t) {
     const Vec3 f1 = spring_damper_force(
         Vec3(x1[t], x1[nx + t], x1[2 * nx + t]), Vec3(x2[t], x2[nx + t], x2[2 * nx + t]),
-        Vec3(v1[t], v1[nv + t], v1[2 * nv + t]), Vec3(v2[t], v2[nv + t], v2[2 * nv + t]), ks[t],
-        kd[t], l0[t]);
+        Vec3(v1[t], v1[nv + t], v1[2 * nv + t]), Vec3(v2[t], v2[nv + t], v2[2 * nv + t]),
+        ks[Uniform ? 0 : t], kd[Uniform ? 0 : t], l0[t]);
     f1x[t] = f1.x();
     f1y[t] = f1.y();
     f1z[t] = f1.z();
   }
+}
+
+}  // namespace
+
+void spring_forces_of_run(Index count, Index nx, Index nv, const double* x1, const double* x2,
+                          const double* v1, const double* v2, const double* ks, const double* kd,
+                          const double* l0, double* f1x, double* f1y, double* f1z, bool uniform) {
+  (uniform ? forces_of_run<true> : forces_of_run<false>)(count, nx, nv, x1, x2, v1, v2, ks, kd, l0,
+                                                         f1x, f1y, f1z);
 }
 
 namespace {
@@ -158,12 +178,12 @@ constexpr Index kChunk = 256;  // springs per chunk: f1 of a chunk takes 6 KiB
 // passes, upper first, as on the readable path, and nothing is stored only to be read back.
 // (SpringDampers::kDirectGap; add_run takes this path for such runs.)
 
-// Springs t = 0 .. count - 1 of a run (inputs as in spring_forces_of_run), their forces added to
+// Springs t = 0 .. count - 1 of a run (inputs as in forces_of_run), their forces added to
 // the upper ends (f_upper[c n + t], if ToUpper) and the lower ends (f_lower[c n + t], if ToLower):
 // +f1 to the i end and -f1 to the j end. f_upper and f_lower point into the same array,
 // kDirectGap or more apart, which is why they are not restrict. `flatten` asks for the kernel
-// inlined at link time, as in spring_forces_of_run: for these six instances GCC declines otherwise.
-template <bool UpperIsJ, bool ToUpper, bool ToLower>
+// inlined at link time, as in forces_of_run: for these twelve instances GCC declines otherwise.
+template <bool Uniform, bool UpperIsJ, bool ToUpper, bool ToLower>
 [[gnu::noinline, gnu::flatten]] void run_kernel_direct(
     Index count, Index nx, Index nv, Index n, const double* __restrict x1,
     const double* __restrict x2, const double* __restrict v1, const double* __restrict v2,
@@ -182,8 +202,8 @@ template <bool UpperIsJ, bool ToUpper, bool ToLower>
   for (Index t = 0; t < count; ++t) {
     const Vec3 f1 = spring_damper_force(
         Vec3(x1[t], x1[nx + t], x1[2 * nx + t]), Vec3(x2[t], x2[nx + t], x2[2 * nx + t]),
-        Vec3(v1[t], v1[nv + t], v1[2 * nv + t]), Vec3(v2[t], v2[nv + t], v2[2 * nv + t]), ks[t],
-        kd[t], l0[t]);
+        Vec3(v1[t], v1[nv + t], v1[2 * nv + t]), Vec3(v2[t], v2[nv + t], v2[2 * nv + t]),
+        ks[Uniform ? 0 : t], kd[Uniform ? 0 : t], l0[t]);
     // The i end gets +f1, the j end -f1. Component by component, written out: the compiler
     // keeps f1 in registers only if no loop index picks its components.
     double* const f_i = UpperIsJ ? f_lower : f_upper;
@@ -246,9 +266,12 @@ void add_both_shares(Index count, Index n, Index gap, const double* __restrict f
 bool SpringDampers::adds_soa(const Particles& /*p*/) const {
   RunLayout& lay = layout_;
   const SpringSet& s = springs_;
-  if (lay.generation != s.generation || lay.springs != s.size()) {
+  if (lay.generation != s.generation || lay.springs != s.size() ||
+      lay.ks_changes != s.ks.changes() || lay.kd_changes != s.kd.changes()) {
     lay.generation = s.generation;
     lay.springs = s.size();
+    lay.ks_changes = s.ks.changes();
+    lay.kd_changes = s.kd.changes();
     lay.runs = spring_runs(s);
   }
   assert(lay.runs == spring_runs(s) && "i or j changed in place without SpringSet::changed()");
@@ -281,7 +304,7 @@ void SpringDampers::add_run(const SpringRun& run, Index p_begin, Index p_end, co
     spring_forces_of_run(c1 - c0, x.cols(), v.cols(), x.data() + run.i0 + c0,
                          x.data() + run.j0 + c0, v.data() + run.i0 + c0, v.data() + run.j0 + c0,
                          springs_.ks.data() + k, springs_.kd.data() + k, springs_.l0.data() + k, f1,
-                         f1 + kChunk, f1 + 2 * kChunk);
+                         f1 + kChunk, f1 + 2 * kChunk, run.uniform);
     // Springs [u0, u1) of the chunk give upper ends their shares, [l0, l1) lower ends theirs.
     // Upper end upper + t is lower end lower + t + gap: where both fall in this chunk, that
     // particle takes both at once (upper first); the others take theirs one pass at a time.
@@ -321,14 +344,23 @@ void SpringDampers::add_run_direct(const SpringRun& run, Index up_begin, Index u
   const auto springs = [&](Index t0, Index t1, bool to_upper, bool to_lower) {
     if (t0 >= t1) return;
     const Index k = static_cast<Index>(run.k0) + t0;
-    // run_kernel_direct<UpperIsJ, ToUpper, ToLower> by [upper_is_j][to_upper][to_lower].
-    using Kernel = decltype(&run_kernel_direct<false, true, true>);
-    static constexpr Kernel kernels[2][2][2] = {
-        {{nullptr, run_kernel_direct<false, false, true>},
-         {run_kernel_direct<false, true, false>, run_kernel_direct<false, true, true>}},
-        {{nullptr, run_kernel_direct<true, false, true>},
-         {run_kernel_direct<true, true, false>, run_kernel_direct<true, true, true>}}};
-    kernels[upper_is_j][to_upper][to_lower](
+    // run_kernel_direct<Uniform, UpperIsJ, ToUpper, ToLower> by
+    // [uniform][upper_is_j][to_upper][to_lower].
+    using Kernel = decltype(&run_kernel_direct<false, false, true, true>);
+    static constexpr Kernel kernels[2][2][2][2] = {
+        {{{nullptr, run_kernel_direct<false, false, false, true>},
+          {run_kernel_direct<false, false, true, false>,
+           run_kernel_direct<false, false, true, true>}},
+         {{nullptr, run_kernel_direct<false, true, false, true>},
+          {run_kernel_direct<false, true, true, false>,
+           run_kernel_direct<false, true, true, true>}}},
+        {{{nullptr, run_kernel_direct<true, false, false, true>},
+          {run_kernel_direct<true, false, true, false>,
+           run_kernel_direct<true, false, true, true>}},
+         {{nullptr, run_kernel_direct<true, true, false, true>},
+          {run_kernel_direct<true, true, true, false>,
+           run_kernel_direct<true, true, true, true>}}}};
+    kernels[run.uniform][upper_is_j][to_upper][to_lower](
         t1 - t0, x.cols(), v.cols(), f.cols(), x.data() + run.i0 + t0, x.data() + run.j0 + t0,
         v.data() + run.i0 + t0, v.data() + run.j0 + t0, springs_.ks.data() + k,
         springs_.kd.data() + k, springs_.l0.data() + k, f.data() + upper + t0,

@@ -13,6 +13,7 @@
 // springs along the diagonals of each cell, and (lesson 04) bending springs two apart.
 #pragma once
 
+#include <algorithm>
 #include <string>
 #include <utility>
 #include <vector>
@@ -48,17 +49,90 @@ Vec3 spring_damper_force(const Vec3& r1, const Vec3& r2, const Vec3& v1, const V
 // Exercise 2.2: the energy [J] stored in the spring (not the damper), 1/2 ks (l - l0)^2.
 double spring_energy(const Vec3& r1, const Vec3& r2, double ks, double l0);
 
+// Per-spring constants (a SpringSet's ks and kd) that count their changes. The fast path keeps
+// one value for a run of springs that all share it (SpringRun::uniform), so that it need not read
+// the same number once per spring; the count tells it when the values may have changed. It reads
+// and writes as a std::vector<double> does, except that on a non-const column c[k] is a Ref, not
+// a double&: assigning to it counts as a change, and no reference can outlive the count.
+class SpringColumn {
+ public:
+  class Ref {
+   public:
+    Ref& operator=(double value) {
+      column_->values_[k_] = value;
+      ++column_->changes_;
+      return *this;
+    }
+    Ref& operator=(const Ref& other) { return *this = static_cast<double>(other); }
+    Ref(const Ref&) = default;
+    operator double() const { return column_->values_[k_]; }
+
+   private:
+    friend class SpringColumn;
+    Ref(SpringColumn* column, size_t k) : column_(column), k_(k) {}
+    SpringColumn* column_;
+    size_t k_;
+  };
+
+  SpringColumn() = default;
+  SpringColumn(const SpringColumn&) = default;
+  SpringColumn(SpringColumn&&) = default;
+  // Assigning a whole column is a change too, whatever the two counts were.
+  SpringColumn& operator=(const SpringColumn& other) {
+    values_ = other.values_;
+    changes_ = std::max(changes_, other.changes_) + 1;
+    return *this;
+  }
+  SpringColumn& operator=(SpringColumn&& other) noexcept {
+    values_ = std::move(other.values_);
+    changes_ = std::max(changes_, other.changes_) + 1;
+    return *this;
+  }
+
+  double operator[](size_t k) const { return values_[k]; }
+  Ref operator[](size_t k) { return Ref(this, k); }
+  size_t size() const { return values_.size(); }
+  double back() const { return values_.back(); }
+  const double* data() const { return values_.data(); }
+  const std::vector<double>& values() const { return values_; }
+  void push_back(double value) {
+    values_.push_back(value);
+    ++changes_;
+  }
+  void resize(size_t n) {
+    values_.resize(n);
+    ++changes_;
+  }
+  void assign(size_t n, double value) {
+    values_.assign(n, value);
+    ++changes_;
+  }
+  // The values themselves, for changing many at once (reversing, sorting), counted as a change.
+  // Finish with the reference before the next force evaluation: changes made through it after
+  // that are not counted.
+  std::vector<double>& edit() {
+    ++changes_;
+    return values_;
+  }
+  // How many changes this column has seen, copies included.
+  unsigned long changes() const { return changes_; }
+
+ private:
+  std::vector<double> values_;
+  unsigned long changes_ = 0;
+};
+
 // A family of springs as parallel arrays: spring k joins particles i[k] and j[k].
 //
 // The fast path (fast_forces.hpp) keeps a description of i and j as runs (see SpringRun), built
-// again whenever `generation` changes. add() and erase() set it to a number no other change, of
-// any set, has had; code that edits i or j in place, or builds a set by push_back, calls
-// changed() afterwards. ks, kd and l0 may change freely (plasticity changes l0 every step): the
-// runs hold indices only.
+// again whenever `generation` changes, or ks or kd change (SpringColumn counts their changes).
+// add() and erase() set `generation` to a number no other change, of any set, has had; code that
+// edits i or j in place, or builds a set by push_back, calls changed() afterwards. ks and kd may
+// be changed in place, and l0 freely (plasticity changes it every step): the runs hold no l0.
 struct SpringSet {
   std::vector<Index> i, j;
-  std::vector<double> ks;        // spring constants [N/m]
-  std::vector<double> kd;        // damping factors [N s/m]
+  SpringColumn ks;               // spring constants [N/m]
+  SpringColumn kd;               // damping factors [N s/m]
   std::vector<double> l0;        // rest lengths [m]; plasticity (lesson 06) may change them
   std::vector<double> l_built;   // rest lengths as built [m], for plastic strain limits
   unsigned long generation = 0;  // which change to i and j this set is at (see above)
@@ -77,14 +151,17 @@ struct SpringSet {
 // such runs (the row springs of row r are one, with j0 = i0 + 1), so a loop over a run reads
 // positions and writes forces in memory order, with no index arrays to chase.
 struct SpringRun {
-  size_t k0;     // first spring of the run in the set
-  Index i0, j0;  // particles of its first spring
-  Index length;  // springs in the run
+  size_t k0;             // first spring of the run in the set
+  Index i0, j0;          // particles of its first spring
+  Index length;          // springs in the run
+  bool uniform = false;  // all its springs have the ks and the kd of its first
   bool operator==(const SpringRun&) const = default;
 };
 
 // The springs of `s`, in their order, cut into the longest runs they form. A set without such
-// structure comes out as runs of length 1; the runs always cover every spring exactly once.
+// structure comes out as runs of length 1; the runs always cover every spring exactly once. A
+// run is `uniform` when its springs share one ks and one kd (a family added by
+// add_spring_family): the fast path then reads them once for the run.
 std::vector<SpringRun> spring_runs(const SpringSet& s);
 
 // The fast path's inner loop: the forces f1 of springs t = 0 .. count - 1 of a run, through
@@ -92,12 +169,12 @@ std::vector<SpringRun> spring_runs(const SpringSet& s);
 // x1[2 nx + t] and x2[t], ... (nx: the stride of x's rows), with velocities at v1[t],
 // v1[nv + t], ...; its constants are ks[t], kd[t], l0[t], and f1 goes to f1x[t], f1y[t],
 // f1z[t]. No two arrays may overlap. Compiled with the kernel inlined (link-time optimisation),
-// it evaluates four springs at once; `clothlab bench speed` times it alone.
-void spring_forces_of_run(Index count, Index nx, Index nv, const double* __restrict x1,
-                          const double* __restrict x2, const double* __restrict v1,
-                          const double* __restrict v2, const double* __restrict ks,
-                          const double* __restrict kd, const double* __restrict l0,
-                          double* __restrict f1x, double* __restrict f1y, double* __restrict f1z);
+// it evaluates four or eight springs at once; `clothlab bench speed` times it alone. With
+// `uniform`, every spring has the constants ks[0] and kd[0] (SpringRun::uniform).
+void spring_forces_of_run(Index count, Index nx, Index nv, const double* x1, const double* x2,
+                          const double* v1, const double* v2, const double* ks, const double* kd,
+                          const double* l0, double* f1x, double* f1y, double* f1z,
+                          bool uniform = false);
 
 // The spring effect of `world` called `name` ("springs" or "bending"), or nullptr.
 SpringDampers* find_spring_effect(World& world, std::string_view name);
@@ -151,6 +228,7 @@ class SpringDampers final : public ForceEffect {
   struct RunLayout {
     unsigned long generation = 0;
     size_t springs = 0;
+    unsigned long ks_changes = 0, kd_changes = 0;  // SpringColumn::changes() when built
     std::vector<SpringRun> runs;
   };
   mutable RunLayout layout_;

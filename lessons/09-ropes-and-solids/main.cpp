@@ -113,7 +113,7 @@ struct Hanging {
 Hanging hang(int sweeps, double stiffer, double dt) {
   Scene scene = load_scene_file(lesson_file("sagging-cloth.toml"));
   World& w = scene.world;
-  for (double& ks : springs_of(w).ks)
+  for (double& ks : springs_of(w).ks.edit())
     ks *= stiffer;
   if (sweeps > 0)
     w.post_step_effects.push_back(std::make_unique<StrainLimiting>(StrainLimits{0.1, 1.0}, sweeps));
@@ -154,7 +154,7 @@ void hanging_cloth() {
   // step that stiffness needs.
   const double factor = soft.strain / 0.1;
   Scene stiff = load_scene_file(lesson_file("sagging-cloth.toml"));
-  for (double& ks : springs_of(stiff.world).ks)
+  for (double& ks : springs_of(stiff.world).ks.edit())
     ks *= factor;
   const double dt_stiff = advise_time_step(stiff.world, dt, stiff.step_count()).dt_limit;
   const double dt_run = std::min(dt, 0.9 * dt_stiff);

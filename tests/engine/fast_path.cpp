@@ -119,6 +119,81 @@ TEST_CASE("fast path: runs cover every spring of a set once and in order") {
   }
 }
 
+TEST_CASE("fast path: a spring column counts every change, and only changes") {
+  clothlab::SpringColumn c;
+  c.push_back(1.0);
+  c.push_back(2.0);
+  const unsigned long built = c.changes();
+  CHECK(built == 2);
+  const double read = c[1];  // through the non-const column: a read, not a change
+  CHECK(read == 2.0);
+  CHECK(c.changes() == built);
+  c[0] = 5.0;
+  CHECK(c[0] == 5.0);
+  CHECK(c.changes() == built + 1);
+  c[1] = c[0];  // element to element: a change of the value, not of the reference
+  CHECK(c[1] == 5.0);
+  CHECK(c.changes() == built + 2);
+  c.edit()[0] = 7.0;
+  CHECK(c[0] == 7.0);
+  CHECK(c.changes() == built + 3);
+  clothlab::SpringColumn d;
+  d.push_back(9.0);
+  d = c;  // a whole column assigned: counted, even from a column with fewer changes
+  CHECK(d.values() == c.values());
+  CHECK(d.changes() > c.changes());
+}
+
+TEST_CASE("fast path: a run is uniform while its springs share ks and kd") {
+  clothlab::Scene scene = clothlab::parse_scene(cloth(""), "runs.toml");
+  clothlab::SpringSet& s = spring_effect(scene.world, "springs")->springs();
+  std::vector<clothlab::SpringRun> runs = clothlab::spring_runs(s);
+  // Each family is added with one ks and one kd: every run is uniform.
+  CHECK(std::all_of(runs.begin(), runs.end(), [](const auto& r) { return r.uniform; }));
+  // One spring in the middle of the fifth run gets its own kd; that run alone is not uniform.
+  const clothlab::SpringRun fifth = runs[4];
+  REQUIRE(fifth.length > 2);
+  s.kd[fifth.k0 + 1] = 2.0 * s.kd[fifth.k0];
+  runs = clothlab::spring_runs(s);
+  for (size_t r = 0; r < runs.size(); ++r) {
+    CAPTURE(r);
+    CHECK(runs[r].uniform == (r != 4));
+  }
+}
+
+TEST_CASE("fast path: ks and kd changed in place between steps reach the forces") {
+  // The runs layout keeps one ks and kd per uniform run; a change through the set (one spring
+  // of a run, or every spring of another) must reach the next step, as on the readable path.
+  const auto edit = [](clothlab::World& w) {
+    clothlab::SpringSet& s = clothlab::find_spring_effect(w, "springs")->springs();
+    const std::vector<clothlab::SpringRun> runs = clothlab::spring_runs(s);
+    s.ks[runs[3].k0 + 5] = 3.0 * s.ks[runs[3].k0 + 5];
+    for (Index t = 0; t < runs.back().length; ++t)
+      s.kd[runs.back().k0 + static_cast<size_t>(t)] = 0.5;
+    for (double& ks : clothlab::find_spring_effect(w, "bending")->springs().ks.edit())
+      ks *= 4.0;
+  };
+  for (int threads : {1, 2}) {
+    CAPTURE(threads);
+    std::vector<clothlab::Scene> scenes;
+    for (bool fast : {false, true}) {
+      clothlab::Scene scene = run(cloth(""), fast, threads, 40);
+      edit(scene.world);
+      for (int step = 0; step < 40; ++step)
+        scene.world.step(scene.dt);
+      scenes.push_back(std::move(scene));
+    }
+    const clothlab::World& readable = scenes[0].world;
+    const clothlab::World& fast = scenes[1].world;
+    CHECK(fast.fast_evaluations == fast.force_evaluations);
+    CHECK(identical(fast.particles.x, readable.particles.x));
+    CHECK(identical(fast.particles.v, readable.particles.v));
+    // The edits changed the motion: without them the state differs.
+    const clothlab::Scene unedited = run(cloth(""), true, threads, 80);
+    CHECK_FALSE(identical(unedited.world.particles.x, fast.particles.x));
+  }
+}
+
 TEST_CASE("fast path: the builders' runs order keeps the same springs as the pairs listed") {
   const Index rows = 7, cols = 5;
   clothlab::Particles p;

@@ -73,7 +73,7 @@ double total_energy(const clothlab::World& world) {
 // an explicit method is stable for dt below about 2 / w_max (symplectic Euler's limit for a
 // linear spring of frequency w); with kd it bounds the fastest damping rate [1/s]. Every spring
 // effect counts ("springs" and "bending"). The bound may overestimate, never underestimate.
-double spring_bound(const clothlab::World& world, std::vector<double> clothlab::SpringSet::*c) {
+double spring_bound(const clothlab::World& world, clothlab::SpringColumn clothlab::SpringSet::*c) {
   const clothlab::Particles& p = world.particles;
   std::vector<double> sum(static_cast<size_t>(p.size()), 0.0);
   for (const auto& effect : world.force_effects) {

@@ -108,7 +108,7 @@ TEST_CASE("tearing: which springs tear does not depend on their order in the lis
     clothlab::Scene b = clothlab::parse_scene(test::storm(), "b.toml");
     b.world.particles = a.world.particles;
     clothlab::SpringSet& sb = test::springs_of(b.world);
-    for (auto* column : {&sb.ks, &sb.kd, &sb.l0, &sb.l_built})
+    for (std::vector<double>* column : {&sb.ks.edit(), &sb.kd.edit(), &sb.l0, &sb.l_built})
       std::reverse(column->begin(), column->end());
     std::reverse(sb.i.begin(), sb.i.end());
     std::reverse(sb.j.begin(), sb.j.end());
