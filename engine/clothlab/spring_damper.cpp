@@ -2,7 +2,9 @@
 
 #include <algorithm>
 #include <atomic>
+#include <bit>
 #include <cassert>
+#include <cstdint>
 #include <utility>
 
 #include "clothlab/world.hpp"
@@ -51,6 +53,16 @@ void SpringSet::changed() {
   generation = ++changes;
 }
 
+namespace {
+
+// The same double, bit for bit: -0.0 and 0.0 differ here, which == would not see, and the fast
+// path must compute a uniform run's springs with their own bits.
+bool same_bits(double a, double b) {
+  return std::bit_cast<std::uint64_t>(a) == std::bit_cast<std::uint64_t>(b);
+}
+
+}  // namespace
+
 std::vector<SpringRun> spring_runs(const SpringSet& s) {
   std::vector<SpringRun> runs;
   for (size_t k = 0; k < s.size(); ++k) {
@@ -58,7 +70,8 @@ std::vector<SpringRun> spring_runs(const SpringSet& s) {
     if (!runs.empty()) {
       SpringRun& last = runs.back();
       if (s.i[k] == last.i0 + last.length && s.j[k] == last.j0 + last.length) {
-        last.uniform = last.uniform && s.ks[k] == s.ks[last.k0] && s.kd[k] == s.kd[last.k0];
+        last.uniform =
+            last.uniform && same_bits(s.ks[k], s.ks[last.k0]) && same_bits(s.kd[k], s.kd[last.k0]);
         ++last.length;
         continue;
       }

@@ -154,7 +154,7 @@ struct SpringRun {
   size_t k0;             // first spring of the run in the set
   Index i0, j0;          // particles of its first spring
   Index length;          // springs in the run
-  bool uniform = false;  // all its springs have the ks and the kd of its first
+  bool uniform = false;  // all its springs have the ks and the kd of its first, bit for bit
   bool operator==(const SpringRun&) const = default;
 };
 

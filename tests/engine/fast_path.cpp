@@ -154,10 +154,16 @@ TEST_CASE("fast path: a run is uniform while its springs share ks and kd") {
   const clothlab::SpringRun fifth = runs[4];
   REQUIRE(fifth.length > 2);
   s.kd[fifth.k0 + 1] = 2.0 * s.kd[fifth.k0];
+  // The third run's kd all 0, one of them -0: equal by ==, not bit for bit, and not uniform (a
+  // product with -0 can round to a zero of the other sign).
+  const clothlab::SpringRun third = runs[2];
+  for (Index t = 0; t < third.length; ++t)
+    s.kd[third.k0 + static_cast<size_t>(t)] = 0.0;
+  s.kd[third.k0 + 1] = -0.0;
   runs = clothlab::spring_runs(s);
   for (size_t r = 0; r < runs.size(); ++r) {
     CAPTURE(r);
-    CHECK(runs[r].uniform == (r != 4));
+    CHECK(runs[r].uniform == (r != 4 && r != 2));
   }
 }
 
