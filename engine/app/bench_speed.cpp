@@ -327,7 +327,7 @@ struct BareCloth {
   // As on the engine's fast path, each thread owns a contiguous range of particles and takes it
   // a block at a time (World::pass_block): it sums the block's forces, then moves it into `next`.
   void step(double dt) {
-    const Index block = world->pass_block;
+    const Index block = std::max<Index>(world->pass_block, 1);
     for_ranges(team.get(), world->particles.size(), [&](Index begin, Index end) {
       for (Index b0 = begin; b0 < end; b0 += block)
         step_range(b0, std::min(b0 + block, end), dt, next.x.data(), next.v.data());
