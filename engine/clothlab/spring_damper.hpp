@@ -52,8 +52,9 @@ double spring_energy(const Vec3& r1, const Vec3& r2, double ks, double l0);
 // Per-spring constants (a SpringSet's ks and kd) that count their changes. The fast path keeps
 // one value for a run of springs that all share it (SpringRun::uniform), so that it need not read
 // the same number once per spring; the count tells it when the values may have changed. It reads
-// and writes as a std::vector<double> does, except that on a non-const column c[k] is a Ref, not
-// a double&: assigning to it counts as a change, and no reference can outlive the count.
+// and writes like a std::vector<double> (c[k], size, push_back), except that on a non-const
+// column c[k] is a Ref, not a double&: assigning to it counts as a change, and no reference can
+// outlive the count. A loop over every value goes through edit().
 class SpringColumn {
  public:
   class Ref {

@@ -70,8 +70,8 @@ class World {
   // the effects; the two paths give the same f, bit for bit.
   void compute_forces(const Matrix3X& x, const Matrix3X& v, Matrix3X& f) const;
 
-  // compute_forces, then move(begin, end) on contiguous ranges of particles that cover them all
-  // once, as for_particles does: an integrator's update, which may read f and change the state
+  // compute_forces, then move(begin, end, copies) on contiguous ranges of particles that cover
+  // each once, as for_particles does: an integrator's update, which may read f and change the state
   // of particles [begin, end) only. On the fast path each thread moves its own particles as soon
   // as their forces are summed, a block at a time (pass_block), in the same pass over them, and
   // the guard can check each particle there (World::step); the move may read x, v and f from the
