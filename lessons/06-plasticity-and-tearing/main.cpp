@@ -171,6 +171,8 @@ void order_independence() {
   Scene as_built = load_scene_file(lesson_file("tearing-sheet.toml"));
   Scene reversed = load_scene_file(lesson_file("tearing-sheet.toml"));
   SpringSet& s = springs_of(reversed.world);
+  // ks and kd count their changes (SpringColumn, spring_damper.hpp): edit() hands out their
+  // values for a change to all of them, and tells the engine's fast path to look again.
   for (std::vector<double>* v : {&s.ks.edit(), &s.kd.edit(), &s.l0, &s.l_built})
     std::reverse(v->begin(), v->end());
   std::reverse(s.i.begin(), s.i.end());

@@ -113,6 +113,7 @@ struct Hanging {
 Hanging hang(int sweeps, double stiffer, double dt) {
   Scene scene = load_scene_file(lesson_file("sagging-cloth.toml"));
   World& w = scene.world;
+  // edit(): every spring constant at once, a change the fast path is told of (SpringColumn).
   for (double& ks : springs_of(w).ks.edit())
     ks *= stiffer;
   if (sweeps > 0)
