@@ -144,6 +144,13 @@ int main(int argc, char** argv) {
     return 1;
   }
 
+  // An unchanged stub is left as it is, so that nothing built from it is rebuilt.
+  {
+    std::ifstream old(argv[2], std::ios::binary);
+    std::ostringstream before;
+    before << old.rdbuf();
+    if (old && before.str() == stub) return 0;
+  }
   std::ofstream out(argv[2], std::ios::binary);
   out << stub;
   if (!out.flush()) {
