@@ -26,10 +26,17 @@ std::string read_text(const fs::path& path) {
   return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
 }
 
-// Copies `from` to `to` only when the contents differ, so that the scratch build recompiles only
-// the files that changed since the submission graded before.
-void copy_if_different(const fs::path& from, const fs::path& to) {
-  if (fs::exists(to) && read_text(from) == read_text(to)) return;
+// Puts the exercise file `from` into the scratch folder as `to`, so that the scratch build
+// recompiles only the files that changed since it last ran: copied only when the contents
+// differ, and left out when it is its shipped `stub` as is (the kit links the stub's object,
+// which the project's build already compiled).
+void take_file(const fs::path& from, const fs::path& to, const fs::path& stub) {
+  const std::string text = read_text(from);
+  if (text == read_text(stub)) {
+    fs::remove(to);
+    return;
+  }
+  if (fs::exists(to) && text == read_text(to)) return;
   fs::copy_file(from, to, fs::copy_options::overwrite_existing);
 }
 
@@ -69,7 +76,58 @@ std::string replace_all(std::string text, const std::string& from, const std::st
   return text;
 }
 
+// The build tool's option to go on past a failed file, so that every file that does not compile
+// is found in one build.
+std::vector<std::string> keep_going_args() {
+  const std::string generator = CLOTHLAB_CMAKE_GENERATOR;
+  if (generator.find("Ninja") != std::string::npos) return {"--", "-k", "0"};
+  if (generator.find("Makefiles") != std::string::npos) return {"--", "-k"};
+  return {};
+}
+
+// Whether the build log says that compiling `name` (an exercise file) failed: make's
+// "*** [.../01_x.cpp.o] Error 1", or ninja's "FAILED: .../01_x.cpp.o".
+bool compile_failed(const std::string& log, const std::string& name) {
+  const std::string object = "/" + name + ".o";
+  std::istringstream in(log);
+  for (std::string line; std::getline(in, line);) {
+    const bool failure =
+        (line.find("***") != std::string::npos && line.find("Error") != std::string::npos) ||
+        line.starts_with("FAILED:");
+    if (failure && line.find(object) != std::string::npos) return true;
+  }
+  return false;
+}
+
 }  // namespace
+
+std::string update_grade_kit(double timeout) {
+  std::error_code ec;
+  const fs::path self = fs::read_symlink("/proc/self/exe", ec);
+  if (ec) return "";
+  const fs::path build = self.parent_path();
+  // A folder the program was copied to (an autograder's, say) is no build to update.
+  if (!fs::exists(build / "CMakeCache.txt", ec)) return "";
+  const long jobs = std::max(1L, sysconf(_SC_NPROCESSORS_ONLN));
+  const ProcessResult run =
+      run_process({CLOTHLAB_CMAKE_COMMAND, "--build", build.string(), "--target", "grade-kit",
+                   "--parallel", std::to_string(jobs)},
+                  timeout);
+  if (run.interrupted) return "interrupted while building the engine and the grading tests";
+  if (run.timed_out)
+    return fmt::format("building the engine and the grading tests took longer than {:g} s",
+                       timeout);
+  if (run.exit_code != 0 || run.signal != 0) {
+    std::string error = first_build_error(run.output);
+    if (error.empty())
+      error = run.output.substr(run.output.size() > 4000 ? run.output.size() - 4000 : 0);
+    return fmt::format(
+        "building the engine and the grading tests ({} --build {} --target "
+        "grade-kit) failed:\n{}",
+        CLOTHLAB_CMAKE_COMMAND, build.string(), error);
+  }
+  return "";
+}
 
 std::string grade_kit_dir() {
   std::error_code ec;
@@ -77,7 +135,7 @@ std::string grade_kit_dir() {
   return ((ec ? fs::current_path() : self.parent_path()) / "grade-kit").string();
 }
 
-std::string first_build_error(const std::string& log, int max_lines) {
+std::string first_build_error(const std::string& log, int max_lines, const std::string& in_file) {
   std::istringstream in(log);
   std::vector<std::string> lines;
   for (std::string line; std::getline(in, line);)
@@ -88,6 +146,7 @@ std::string first_build_error(const std::string& log, int max_lines) {
                        line.find("undefined reference") != std::string::npos;
     // make's own "*** [...] Error 1" lines follow the real message; they are not it.
     if (!error || line.starts_with("make") || line.starts_with("gmake")) continue;
+    if (!in_file.empty() && !line.starts_with(in_file + ":")) continue;
     std::string text;
     // The compiler names the function first ("x.cpp: In function '...':").
     if (i > 0 && lines[i - 1].find(": In ") != std::string::npos) text = lines[i - 1] + "\n";
@@ -104,7 +163,7 @@ std::string first_build_error(const std::string& log, int max_lines) {
 }
 
 SubmissionBuild build_submission(const std::string& submission_dir, const std::string& scratch_dir,
-                                 double timeout) {
+                                 double timeout, bool stub_broken_files) {
   const fs::path kit = grade_kit_dir();
   if (!fs::exists(kit / "CMakeLists.txt")) {
     throw std::runtime_error(fmt::format(
@@ -130,10 +189,10 @@ SubmissionBuild build_submission(const std::string& submission_dir, const std::s
     const fs::path found = find_in_submission(from, file.name);
     if (found.empty()) {
       result.missing.push_back(file.name);
-      copy_if_different(file.stub, exercises / file.name);
+      take_file(file.stub, exercises / file.name, file.stub);
     } else {
       result.taken.push_back(file.name);
-      copy_if_different(found, exercises / file.name);
+      take_file(found, exercises / file.name, file.stub);
     }
   }
   for (const fs::path& dir : {from, from / "exercises"}) {
@@ -153,29 +212,57 @@ SubmissionBuild build_submission(const std::string& submission_dir, const std::s
   const auto shown = [&](const std::string& text) {
     return replace_all(text, exercises.string() + "/", "exercises/");
   };
-  const ProcessResult configure =
-      run_process({CLOTHLAB_CMAKE_COMMAND, "-S", kit.string(), "-B", build.string(),
-                   "-DCLOTHLAB_EXERCISES=" + exercises.string()},
-                  timeout);
-  result.log = shown(configure.output);
-  if (configure.interrupted) {
-    result.first_error = "the grader was interrupted while configuring the build";
-    return result;
-  }
-  if (configure.timed_out || configure.exit_code != 0 || configure.signal != 0) {
-    result.first_error = "configuring the submission's build failed:\n" + result.log;
-    return result;
+  // Configured once per scratch folder: the build tool configures again by itself when the kit
+  // changes, and the exercise files keep their names.
+  const fs::path configured = build / "clothlab-configured";
+  if (!fs::exists(configured, ec)) {
+    const ProcessResult configure =
+        run_process({CLOTHLAB_CMAKE_COMMAND, "-G", CLOTHLAB_CMAKE_GENERATOR, "-S", kit.string(),
+                     "-B", build.string(), "-DCLOTHLAB_EXERCISES=" + exercises.string()},
+                    timeout);
+    result.log = shown(configure.output);
+    if (configure.interrupted) {
+      result.first_error = "the grader was interrupted while configuring the build";
+      return result;
+    }
+    if (configure.timed_out || configure.exit_code != 0 || configure.signal != 0) {
+      result.first_error = "configuring the submission's build failed:\n" + result.log;
+      return result;
+    }
+    std::ofstream(configured) << "configured\n";
   }
   const long jobs = std::max(1L, sysconf(_SC_NPROCESSORS_ONLN));
-  const ProcessResult compile = run_process(
-      {CLOTHLAB_CMAKE_COMMAND, "--build", build.string(), "--parallel", std::to_string(jobs)},
-      timeout);
+  std::vector<std::string> args{CLOTHLAB_CMAKE_COMMAND, "--build", build.string(), "--parallel",
+                                std::to_string(jobs)};
+  if (stub_broken_files) {
+    for (const std::string& arg : keep_going_args())
+      args.push_back(arg);
+  }
+  ProcessResult compile = run_process(args, timeout);
   result.log += shown(compile.output);
+
+  // The student's loop: a file that does not compile gives way to its stub, and the build is
+  // tried again, so that the other exercises are graded on what their files say.
+  const bool failed = compile.exit_code != 0 || compile.signal != 0 || !fs::exists(binary, ec);
+  if (stub_broken_files && failed && !compile.interrupted && !compile.timed_out) {
+    for (const ExerciseFile& file : files) {
+      if (!compile_failed(compile.output, file.name)) continue;
+      std::string error = first_build_error(shown(compile.output), 8, "exercises/" + file.name);
+      if (error.empty()) error = first_build_error(shown(compile.output));
+      result.broken.push_back({file.name, error});
+      take_file(file.stub, exercises / file.name, file.stub);
+    }
+    if (!result.broken.empty()) {
+      compile = run_process(args, timeout);
+      result.log += shown(compile.output);
+    }
+  }
+
   if (compile.interrupted) {
     result.first_error = "the grader was interrupted while compiling the submission";
   } else if (compile.timed_out) {
     result.first_error = fmt::format("compiling the submission took longer than {:g} s", timeout);
-  } else if (compile.exit_code != 0 || compile.signal != 0 || !fs::exists(binary)) {
+  } else if (compile.exit_code != 0 || compile.signal != 0 || !fs::exists(binary, ec)) {
     result.first_error = first_build_error(shown(compile.output));
     if (result.first_error.empty())
       result.first_error = "the build failed:\n" + shown(compile.output).substr(0, 4000);

@@ -21,20 +21,38 @@ struct SubmissionBuild {
   std::vector<std::string> taken;    // exercise files taken from the submission
   std::vector<std::string> missing;  // exercise files it lacks (graded on the shipped stub)
   std::vector<std::string> ignored;  // other .cpp files in it, left out
+  // With stub_broken_files: the exercise files that did not compile, each with the compiler's
+  // first error; the binary holds their shipped stubs instead.
+  struct Broken {
+    std::string name;   // "01_particles_and_euler.cpp"
+    std::string error;  // "exercises/01_particles_and_euler.cpp:12:5: error: ..."
+  };
+  std::vector<Broken> broken;
 };
 
 // Builds the grading binary of the submission in `submission_dir` (exercise files named as in
 // exercises/, at its top or in its exercises/ folder) inside `scratch_dir`, giving up after
 // `timeout` seconds. Throws std::runtime_error when the build kit is missing or the submission
 // folder does not exist; a submission that does not compile is not an error but a result.
+// The scratch folder keeps its build, so grading the same files again recompiles only the files
+// that changed. With `stub_broken_files`, an exercise file that does not compile is replaced by
+// its shipped stub, so that the other files' exercises can still be graded (the student's own
+// loop); without it, one such file means no binary (a submission scores zero).
 SubmissionBuild build_submission(const std::string& submission_dir, const std::string& scratch_dir,
-                                 double timeout);
+                                 double timeout, bool stub_broken_files = false);
+
+// Brings what the kit links (the engine, the grading tests' objects, the shipped stubs' grader)
+// up to date, by building the target grade-kit of the project's build folder (the folder this
+// program is in) when it is one. Returns "" or why it failed.
+std::string update_grade_kit(double timeout);
 
 // The build kit generated next to the running clothlab: <dir of clothlab>/grade-kit.
 std::string grade_kit_dir();
 
 // The first compiler or linker error in a build log ("exercises/01_x.cpp:12:5: error: ..."),
-// with the lines that explain it, at most `max_lines` lines; "" when there is none.
-std::string first_build_error(const std::string& log, int max_lines = 8);
+// with the lines that explain it, at most `max_lines` lines; "" when there is none. With
+// `in_file`, only an error reported at a line of that file counts.
+std::string first_build_error(const std::string& log, int max_lines = 8,
+                              const std::string& in_file = "");
 
 }  // namespace clothlab::app
