@@ -59,6 +59,9 @@ struct Options {
   double build_timeout = 600;  // [s] for configuring, then for compiling, a submission
   bool autolab = false;        // end with Autolab's one-line JSON score summary
   std::string classroom;       // write a GitHub Classroom workflow here, and grade nothing
+  bool hidden = false;         // also the hidden cases of tests/grade-hidden/ (instructors)
+  std::string exercises;       // hidden: the student's exercise files; default exercises/
+  int rounds = 0;              // watch: stop after this many gradings (0: never; for tests)
 };
 
 // One grading test case: what the listing says, then how its run went.
@@ -67,14 +70,17 @@ struct Case {
   int line = 0;
   int points = 0;
   std::string visibility = "visible";  // Gradescope: visible, hidden, after_due_date, ...
+  bool hidden_test = false;            // from tests/grade-hidden/: graded only with --hidden
 
   bool done = false;
   bool passed = false;
   bool not_started = false;   // failed on the stub's NotImplemented
   bool not_compiled = false;  // the submission it was graded on did not compile
+  bool broken_file = false;   // ...because its own exercise file did not (the student's loop)
   std::string status = "not run";
-  std::string message;  // the first failure, with its INFO/CAPTURE hints
-  std::string output;   // what the case printed itself
+  std::string message;    // the first failure, with its INFO/CAPTURE hints
+  std::string diagnosis;  // that failure in one line: its first hint, or what went wrong
+  std::string output;     // what the case printed itself
   double seconds = 0;
 };
 
@@ -247,8 +253,9 @@ void judge(Case& c, const ProcessResult& run, const std::string& binary, double 
   bool ended = false;
   bool reported_pass = false;
   std::string first_failure;
-  std::string missing;  // the exercise a NotImplemented named
-  std::string crash;    // what doctest said when it caught a crash signal
+  std::string first_hint;  // the first failure's first INFO line, or its text
+  std::string missing;     // the exercise a NotImplemented named
+  std::string crash;       // what doctest said when it caught a crash signal
   for (Fields& e : events) {
     // The fewest fields each event has, so that a line cut short cannot crash the grader.
     const std::size_t fields = e[0] == "fail" ? 6 : e[0] == "note" ? 4 : 3;
@@ -257,8 +264,13 @@ void judge(Case& c, const ProcessResult& run, const std::string& binary, double 
       ++starts;
     } else if (e[0] == "fail" || e[0] == "exception") {
       const bool is_fail = e[0] == "fail";
-      if (first_failure.empty())
+      if (first_failure.empty()) {
         first_failure = is_fail ? describe_failure(e) : describe_exception(e);
+        first_hint = !is_fail       ? e[2]
+                     : e.size() > 6 ? e[6]
+                     : e[4].empty() ? e[5]
+                                    : fmt::format("{}( {} ) failed", e[3], e[4]);
+      }
       if (missing.empty()) missing = not_implemented_in(is_fail ? e[5] : e[2]);
       if (!is_fail && e[1] == "crash") crash = e[2];
     } else if (e[0] == "note") {
@@ -311,6 +323,13 @@ void judge(Case& c, const ProcessResult& run, const std::string& binary, double 
     c.message += fmt::format("\nto run this case alone (in a debugger, say): {} --test-case=\"{}\"",
                              binary, c.name);
   }
+  // One line: the first hint when the status alone does not say what went wrong.
+  const std::string line = (c.passed || c.not_started) ? ""
+                           : c.status == "failed" && missing.empty() && !first_hint.empty()
+                               ? first_hint
+                               : c.message;
+  c.diagnosis = line.substr(0, line.find('\n'));
+  if (c.diagnosis.size() > 160) c.diagnosis = c.diagnosis.substr(0, 157) + "...";
 }
 
 // --- Listing and running cases ----------------------------------------------------------------
@@ -342,6 +361,7 @@ std::vector<Case> list_cases(const std::string& binary) {
     // A hidden test (tests/grade-hidden/) shows on Gradescope once the due date has passed,
     // unless it says otherwise with POINTS_VISIBILITY.
     const bool hidden_file = c.file.find("grade-hidden/") != std::string::npos;
+    c.hidden_test = hidden_file;
     c.visibility = !e[6].empty() ? e[6] : hidden_file ? "after_due_date" : "visible";
     constexpr std::string_view kVisibilities[] = {"visible", "hidden", "after_due_date",
                                                   "after_published"};
@@ -430,6 +450,7 @@ std::string summary(const std::vector<Case>& cases, bool colour) {
   const auto yellow = fmt::fg(fmt::terminal_color::yellow);
   std::string s = fmt::format("{:<10} {:>9} {:>9}   {}\n", "Exercise", "Points", "Cases", "Status");
   int earned = 0, max = 0;
+  std::vector<std::string> shown_errors;  // a file's compile error, once for its exercises
   for (const Exercise& x : by_exercise(cases)) {
     earned += x.earned;
     max += x.max;
@@ -454,12 +475,28 @@ std::string summary(const std::vector<Case>& cases, bool colour) {
       status = paint(colour, red, "failing");
     s += fmt::format("{:<10} {:>9} {:>9}   {}\n", x.id, fmt::format("{} / {}", x.earned, x.max),
                      fmt::format("{} / {}", x.passed, x.cases.size()), status);
-    if (first != nullptr && !all_not_started && first->done && !not_compiled) {
+    // A submission that does not build says why once, above the table; an exercise file of the
+    // student's own that does not compile says it here, under the first of its exercises.
+    if (not_compiled && first != nullptr && first->broken_file) {
+      if (std::find(shown_errors.begin(), shown_errors.end(), first->message) ==
+          shown_errors.end()) {
+        shown_errors.push_back(first->message);
+        s += indent(first->message, "    ") + "\n";
+      }
+    } else if (first != nullptr && !all_not_started && first->done && !not_compiled) {
+      // The first failing case in full: what was computed, what was expected, where to read.
       s += fmt::format("    {}: {}\n", paint(colour, fmt::emphasis::bold, first->name),
                        paint(colour, red, first->status));
       if (!first->message.empty()) s += indent(first->message, "      ") + "\n";
       const std::string hint = lesson_hint(x.id);
       if (!hint.empty()) s += "      " + hint + "\n";
+      // Every other one in a line: its name and what went wrong.
+      for (const Case* c : x.cases) {
+        if (c == first || c->passed || !c->done || c->not_compiled) continue;
+        s += fmt::format("    {}: {}{}\n", paint(colour, fmt::emphasis::bold, c->name),
+                         paint(colour, red, c->status),
+                         c->diagnosis.empty() ? "" : ": " + c->diagnosis);
+      }
     }
   }
   s += "\n" +
@@ -670,7 +707,7 @@ std::string classroom_workflow(const std::vector<Case>& cases) {
       "        make libeigen3-dev doctest-dev libfmt-dev libtomlplusplus-dev libcli11-dev\n"
       "    - name: Build the grader\n"
       "      run: cmake -S . -B build && cmake --build build --parallel 4 --target clothlab\n"
-      "        grade-student\n"
+      "        grade-kit\n"
       "{}"
       "    - name: Autograding Reporter\n"
       "      uses: classroom-resources/autograding-grader-reporter@v1\n"
@@ -741,15 +778,81 @@ std::string default_scratch() {
   return (fs::path(grade_kit_dir()).parent_path() / "grade-scratch").string();
 }
 
+// Where the student's own exercises are built for grading, kept from one grading to the next.
+std::string own_scratch() {
+  return (fs::path(grade_kit_dir()).parent_path() / "grade-own").string();
+}
+
+// "01_particles_and_euler.cpp" holds the exercises of lesson 01: ex01.1, ex01.2, ...
+bool in_file(const Case& c, const std::string& file) {
+  const std::string lesson = "ex" + file.substr(0, file.find('_'));
+  return c.exercise == lesson || c.exercise.starts_with(lesson + ".");
+}
+
+// The student's own grading: exercises/ built afresh with the kit (only what changed is
+// recompiled), a file that does not compile standing aside for its stub. Returns the binary to
+// grade, or "" when nothing could be built; marks the cases that cannot be graded.
+std::string build_own(const Options& o, std::vector<Case>& cases, std::string& notes, bool colour) {
+  const std::string dir =
+      o.exercises.empty() ? (fs::path(CLOTHLAB_SOURCE_DIR) / "exercises").string() : o.exercises;
+  if (colour) fmt::print("building your exercises ...");
+  std::fflush(stdout);
+  SubmissionBuild build;
+  try {
+    build =
+        build_submission(dir, o.scratch.empty() ? own_scratch() : o.scratch, o.build_timeout, true);
+  } catch (const std::exception& e) {
+    fail(2, e.what());
+  }
+  if (colour) fmt::print("\r\033[K");
+  if (!build.built) {
+    if (g_interrupted) return "";
+    notes += "Your exercises do not build:\n" + indent(build.first_error, "  ") + "\n\n";
+    for (Case& c : cases) {
+      c.done = true;
+      c.not_compiled = true;
+      c.status = "not compiled";
+      c.message = "the exercises do not build:\n" + build.first_error;
+      c.diagnosis = build.first_error.substr(0, build.first_error.find('\n'));
+    }
+    return "";
+  }
+  for (const SubmissionBuild::Broken& broken : build.broken) {
+    for (Case& c : cases) {
+      if (!in_file(c, broken.name)) continue;
+      c.done = true;
+      c.not_compiled = true;
+      c.broken_file = true;
+      c.status = "not compiled";
+      c.message = "exercises/" + broken.name + " does not compile:\n" + broken.error;
+      c.diagnosis = broken.error.substr(0, broken.error.find('\n'));
+    }
+  }
+  return build.binary;
+}
+
 void grade(const Options& o) {
   const bool submission = !o.submission.empty();
-  std::string binary = submission         ? binary_for("stubs")
+  // The student's own exercises, built before they are graded, so that a grade is never that
+  // of a binary older than the files.
+  const bool own = !submission && o.binary.empty() && o.impl == "student";
+  const bool grading = !o.list && o.classroom.empty();
+  if ((submission || own) &&
+      (grading || !fs::exists(fs::path(grade_kit_dir()).parent_path() / "grade-stubs"))) {
+    const std::string why = update_grade_kit(o.build_timeout);
+    if (!why.empty()) fail(2, why);
+  }
+  std::string binary = submission || own  ? binary_for("stubs")
                        : o.binary.empty() ? binary_for(o.impl)
                                           : o.binary;
   if (!fs::exists(binary)) fail(2, binary + " does not exist");
-  // A submission's cases are listed by the shipped stubs' binary, built from the same grading
-  // tests: nothing of the submission runs outside the process of one case.
+  // The cases of a submission, or of the student's exercises, are listed by the shipped stubs'
+  // binary, built from the same grading tests: nothing of the submission runs outside the
+  // process of one case.
   std::vector<Case> cases = list_cases(binary);
+  // The hidden cases count only when an instructor asks for them: a student's grade has the
+  // cases and points the lessons quote.
+  if (!o.hidden) std::erase_if(cases, [](const Case& c) { return c.hidden_test; });
   if (!o.exercise.empty()) {
     std::erase_if(cases, [&](const Case& c) { return !selected(c, o.exercise); });
     if (cases.empty()) fail(2, "no grading case belongs to exercise " + o.exercise);
@@ -801,7 +904,13 @@ void grade(const Options& o) {
       }
     }
   }
+  if (own) {
+    binary = build_own(o, cases, notes, colour);
+    compiled = !binary.empty();
+    fmt::print("{}", notes);
+  }
   for (std::size_t i = 0; compiled && i < cases.size() && !g_interrupted; ++i) {
+    if (cases[i].done) continue;  // not compiled
     if (colour) fmt::print("\r\033[K[{}/{}] {}", i + 1, cases.size(), cases[i].name.substr(0, 70));
     std::fflush(stdout);
     run_case(binary, cases[i], o.timeout);
@@ -834,15 +943,95 @@ void grade(const Options& o) {
   }
 }
 
+// The exercise files of the student, and when each last changed: what `watch` waits on.
+using Snapshot = std::vector<std::pair<std::string, fs::file_time_type>>;
+Snapshot exercise_files(const fs::path& dir) {
+  Snapshot files;
+  std::error_code ec;
+  for (const auto& entry : fs::directory_iterator(dir, ec)) {
+    if (entry.path().extension() != ".cpp") continue;
+    files.emplace_back(entry.path().filename().string(), entry.last_write_time(ec));
+  }
+  std::sort(files.begin(), files.end());
+  return files;
+}
+
+// `clothlab watch`: grades, then grades again each time an exercise file is saved.
+void watch(Options o) {
+  const fs::path dir =
+      o.exercises.empty() ? fs::path(CLOTHLAB_SOURCE_DIR) / "exercises" : fs::path(o.exercises);
+  const bool terminal = isatty(STDOUT_FILENO) != 0;
+  const std::string what = o.exercise.empty() ? "every exercise" : o.exercise;
+  InterruptGuard guard;  // Ctrl-C while waiting ends the watch
+  std::string changed;
+  for (int round = 1;; ++round) {
+    if (terminal) fmt::print("\033[2J\033[H");  // a clear screen for each grading
+    fmt::print("clothlab watch: {}, graded again each time you save a file in {}/{}\n\n", what,
+               relative_path(dir.string()), changed.empty() ? "" : " (" + changed + " changed)");
+    std::fflush(stdout);
+    try {
+      grade(o);
+    } catch (const CLI::RuntimeError& e) {
+      if (e.get_exit_code() == 130) throw;  // interrupted while grading
+      // Anything else the grader could not do is said; the next save may mend it.
+    }
+    if (o.rounds > 0 && round >= o.rounds) return;
+    fmt::print("\nwaiting for a change in {}/ (Ctrl-C to stop)\n", relative_path(dir.string()));
+    std::fflush(stdout);
+    const Snapshot before = exercise_files(dir);
+    Snapshot now = before;
+    while (now == before) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(250));
+      if (g_interrupted) {
+        fmt::print("stopped\n");
+        return;
+      }
+      now = exercise_files(dir);
+    }
+    changed.clear();
+    for (const auto& file : now) {
+      if (std::find(before.begin(), before.end(), file) == before.end())
+        changed += (changed.empty() ? "" : ", ") + file.first;
+    }
+    // An editor may write a file in more than one go.
+    std::this_thread::sleep_for(std::chrono::milliseconds(150));
+  }
+}
+
 }  // namespace
+
+void add_watch_command(CLI::App& app) {
+  auto o = std::make_shared<Options>();
+  CLI::App* cmd = app.add_subcommand(
+      "watch", "Grade your exercises, then again each time you save one (Ctrl-C to stop)");
+  cmd->add_option("exercise", o->exercise, "Watch one lesson (ex01) or one exercise (ex01.2)")
+      ->check(CLI::Validator(
+          [](std::string& s) {
+            return is_exercise_id(s, true) ? std::string() : "expected exNN or exNN.k";
+          },
+          "exNN[.k]"));
+  cmd->add_option("--timeout", o->timeout, "Seconds a case may run before it is stopped")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
+  cmd->add_option("--exercises", o->exercises, "The folder of exercise files")->group("");
+  cmd->add_option("--scratch", o->scratch, "Where to build them")->group("");
+  cmd->add_option("--rounds", o->rounds, "Stop after this many gradings")->group("");
+  cmd->callback([o] { watch(*o); });
+}
 
 void add_grade_command(CLI::App& app) {
   auto o = std::make_shared<Options>();
   CLI::App* cmd = app.add_subcommand("grade", "Run the grading tests and score each exercise");
   cmd->add_option("--impl", o->impl,
-                  "Which kernels to grade: your exercises, the reference or the shipped stubs")
+                  "Which kernels to grade: your exercises (built first, so the grade is always "
+                  "that of the files as saved), the reference or the shipped stubs")
       ->check(CLI::IsMember({"student", "reference", "stubs"}))
       ->capture_default_str();
+  cmd->add_flag("--hidden", o->hidden,
+                "Also the hidden cases of tests/grade-hidden/ (for instructors: a student's "
+                "grade leaves them out)");
+  cmd->add_option("--exercises", o->exercises, "Grade the exercise files in this folder as yours")
+      ->group("");
   cmd->add_option("--exercise", o->exercise, "Grade one lesson (ex01) or one exercise (ex01.2)")
       ->check(CLI::Validator(
           [](std::string& s) {
@@ -866,7 +1055,8 @@ void add_grade_command(CLI::App& app) {
                   "scratch folder")
       ->excludes(binary);
   cmd->add_option("--scratch", o->scratch,
-                  "Where to build a submission (default: grade-scratch next to clothlab)");
+                  "Where to build a submission (default: grade-scratch next to clothlab; "
+                  "grade-own for your exercises)");
   cmd->add_option("--build-timeout", o->build_timeout,
                   "Seconds configuring, then compiling, a submission may take")
       ->check(CLI::PositiveNumber)

@@ -17,4 +17,7 @@ namespace clothlab::app {
 // 130: interrupted), which CLI11_PARSE / app.exit() turn into main's return value.
 void add_grade_command(CLI::App& app);
 
+// Adds `watch [exNN[.k]]`: grades the student's exercises, then again on every save.
+void add_watch_command(CLI::App& app);
+
 }  // namespace clothlab::app

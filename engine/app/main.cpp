@@ -3,7 +3,8 @@
 //   clothlab                          run the built-in demo scene
 //   clothlab run SCENE.toml [--out D] simulate a scene and write its frames (--threads N)
 //   clothlab validate SCENE.toml      check a scene without running it
-//   clothlab grade [...]              grade the exercises (see grade.cpp)
+//   clothlab grade [...]              build and grade the exercises (see grade.cpp)
+//   clothlab watch [exNN[.k]]         grade again on every save of an exercise file
 //   clothlab bench boundary           measure what the exercise boundary costs
 //   clothlab bench speed              the engine's speed on cloths of 32^2 to 256^2 particles
 //
@@ -166,8 +167,11 @@ int run(Scene& scene, const RunOutputs& outputs, bool stats) {
   }
 }
 
+// clothlab-out/<scene>/ for the reference build, clothlab-out/<scene>-student/ for the student's,
+// so that the two runs of one scene can be compared side by side.
 fs::path default_out_dir(const std::string& scene_path) {
-  return fs::path("clothlab-out") / fs::path(scene_path).stem();
+  const std::string suffix = std::string(app::kKernels) == "student" ? "-student" : "";
+  return fs::path("clothlab-out") / (fs::path(scene_path).stem().string() + suffix);
 }
 
 }  // namespace
@@ -180,7 +184,9 @@ int main(int argc, char** argv) {
   std::string out_dir;
   CLI::App* run_cmd = app.add_subcommand("run", "Simulate a scene and write its frames");
   run_cmd->add_option("scene", scene_path, "Scene file (.toml)")->required();
-  run_cmd->add_option("--out", out_dir, "Output folder (default: clothlab-out/<scene name>)");
+  run_cmd->add_option("--out", out_dir,
+                      "Output folder (default: clothlab-out/<scene name>, or "
+                      "clothlab-out/<scene name>-student for clothlab-student)");
   std::string html;
   bool no_html = false, obj = false, vtk = false, stats = false;
   run_cmd->add_option("--html", html, "Viewer page to write (default: <output folder>/view.html)");
@@ -200,6 +206,7 @@ int main(int argc, char** argv) {
   validate_cmd->add_option("scene", validate_path, "Scene file (.toml)")->required();
 
   app::add_grade_command(app);
+  app::add_watch_command(app);
   app::add_bench_command(app);
 
   try {
@@ -243,7 +250,7 @@ int main(int argc, char** argv) {
     if (app.get_subcommands().empty()) {
       // No command: the demo, so that a first run shows something move.
       Scene scene = parse_scene(app::kDemoScene, app::kDemoSceneSource);
-      return run(scene, RunOutputs::in(fs::path("clothlab-out") / "demo"), false);
+      return run(scene, RunOutputs::in(default_out_dir("demo")), false);
     }
   } catch (const SceneError& error) {
     std::fflush(stdout);

@@ -18,7 +18,7 @@ macro(problem text)
 endmacro()
 
 # The points of every case, from the table (hidden cases included).
-execute_process(COMMAND ${CLOTHLAB} grade --impl stubs --list OUTPUT_VARIABLE table
+execute_process(COMMAND ${CLOTHLAB} grade --impl stubs --hidden --list OUTPUT_VARIABLE table
                 RESULT_VARIABLE code)
 if(NOT code EQUAL 0)
   message(FATAL_ERROR "clothlab grade --list failed:\n${table}")
@@ -60,7 +60,7 @@ function(grade_submission name expected)
   set(results ${WORK_DIR}/${name}.json)
   execute_process(
     COMMAND ${CMAKE_COMMAND} -E env NO_COLOR=1 ${CLOTHLAB} grade --submission ${WORK_DIR}/${name}
-            --scratch ${WORK_DIR}/scratch --results ${results} ${ARGN}
+            --scratch ${WORK_DIR}/scratch --results ${results} --hidden ${ARGN}
     RESULT_VARIABLE code OUTPUT_VARIABLE out ERROR_VARIABLE err)
   message("--- ${name}: exit ${code}\n${out}${err}")
   set(out_${name} "${out}" PARENT_SCOPE)

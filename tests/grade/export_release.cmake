@@ -90,19 +90,21 @@ apt-get install -y --no-install-recommends g++ cmake make libeigen3-dev doctest-
   libtomlplusplus-dev libcli11-dev
 cd "$root/source/clothlab"
 cmake -S . -B build
-cmake --build build --parallel "$(nproc)" --target clothlab grade-stubs
+cmake --build build --parallel "$(nproc)" --target clothlab grade-kit
 ]=])
 file(WRITE ${OUT}/run_autograder [=[#!/usr/bin/env bash
 # Gradescope runs this for every submission: it grades the exercise files in
 # /autograder/submission (at its top or in an exercises/ folder; a missing file counts as the
-# shipped stub) and writes /autograder/results/results.json. Each case runs in its own process
-# with a timeout; a submission that does not compile scores zero with the compiler's error.
+# shipped stub) and writes /autograder/results/results.json, hidden cases included. Each case
+# runs in its own process with a timeout; a submission that does not compile scores zero with
+# the compiler's error.
 set -uo pipefail
 root=${AUTOGRADER_ROOT:-/autograder}
 mkdir -p "$root/results"
 cd "$root/source/clothlab"
 NO_COLOR=1 ./build/clothlab grade --submission "$root/submission" \
-  --scratch "$root/source/clothlab/build/submission" --results "$root/results/results.json"
+  --scratch "$root/source/clothlab/build/submission" --results "$root/results/results.json" \
+  --hidden
 ]=])
 file(CHMOD ${OUT}/setup.sh ${OUT}/run_autograder
      PERMISSIONS OWNER_READ OWNER_WRITE OWNER_EXECUTE GROUP_READ GROUP_EXECUTE WORLD_READ
