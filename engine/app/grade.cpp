@@ -244,6 +244,17 @@ std::string describe_exception(const Fields& e) {
   return s;
 }
 
+// A failed check in one line: its teaching hint. The contexts run from the outermost INFO (the
+// setup, "a 3 x 3 grid") in; the innermost that is neither a CAPTURE ("y := 0.5") nor the
+// check's own "got ..., expected ..." is the hint. Failing that, the check itself.
+std::string hint_of(const Fields& e) {
+  for (std::size_t i = e.size(); i-- > 6;) {
+    if (e[i].find(" := ") == std::string::npos && !e[i].starts_with("got ")) return e[i];
+  }
+  if (e.size() > 6) return e.back();
+  return e[4].empty() ? e[5] : fmt::format("{}( {} ) failed", e[3], e[4]);
+}
+
 // Decides a case's status from how its process ended and what its reporter said.
 void judge(Case& c, const ProcessResult& run, const std::string& binary, double timeout) {
   std::vector<Fields> events;
@@ -253,7 +264,7 @@ void judge(Case& c, const ProcessResult& run, const std::string& binary, double 
   bool ended = false;
   bool reported_pass = false;
   std::string first_failure;
-  std::string first_hint;  // the first failure's first INFO line, or its text
+  std::string first_hint;  // the first failure in one line (hint_of), or the exception's text
   std::string missing;     // the exercise a NotImplemented named
   std::string crash;       // what doctest said when it caught a crash signal
   for (Fields& e : events) {
@@ -266,10 +277,7 @@ void judge(Case& c, const ProcessResult& run, const std::string& binary, double 
       const bool is_fail = e[0] == "fail";
       if (first_failure.empty()) {
         first_failure = is_fail ? describe_failure(e) : describe_exception(e);
-        first_hint = !is_fail       ? e[2]
-                     : e.size() > 6 ? e[6]
-                     : e[4].empty() ? e[5]
-                                    : fmt::format("{}( {} ) failed", e[3], e[4]);
+        first_hint = is_fail ? hint_of(e) : e[2];
       }
       if (missing.empty()) missing = not_implemented_in(is_fail ? e[5] : e[2]);
       if (!is_fail && e[1] == "crash") crash = e[2];
