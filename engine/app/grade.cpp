@@ -732,10 +732,8 @@ std::string binary_for(const std::string& impl) {
   if (impl == "reference" && !CLOTHLAB_HAVE_SOLUTIONS) {
     fail(2, "this is a student release: it has no reference solutions to grade");
   }
-  // The grading binaries are built next to clothlab and clothlab-student.
-  std::error_code ec;
-  const fs::path self = fs::read_symlink("/proc/self/exe", ec);
-  const fs::path path = (ec ? fs::current_path() : self.parent_path()) / ("grade-" + impl);
+  // The grading binaries are built next to clothlab.
+  const fs::path path = fs::path(build_dir()) / ("grade-" + impl);
   if (!fs::exists(path)) {
     fail(2, fmt::format(
                 "{} does not exist: build it first with\n  cmake --build build --target grade-{}",

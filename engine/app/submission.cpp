@@ -101,11 +101,18 @@ bool compile_failed(const std::string& log, const std::string& name) {
 
 }  // namespace
 
-std::string update_grade_kit(double timeout) {
+std::string build_dir() {
   std::error_code ec;
   const fs::path self = fs::read_symlink("/proc/self/exe", ec);
-  if (ec) return "";
-  const fs::path build = self.parent_path();
+  if (ec) return fs::current_path().string();
+  // A student program lives in student-programs/ of the build folder (engine/CMakeLists.txt).
+  const fs::path dir = self.parent_path();
+  return (dir.filename() == "student-programs" ? dir.parent_path() : dir).string();
+}
+
+std::string update_grade_kit(double timeout) {
+  std::error_code ec;
+  const fs::path build = build_dir();
   // A folder the program was copied to (an autograder's, say) is no build to update.
   if (!fs::exists(build / "CMakeCache.txt", ec)) return "";
   const long jobs = std::max(1L, sysconf(_SC_NPROCESSORS_ONLN));
@@ -130,9 +137,7 @@ std::string update_grade_kit(double timeout) {
 }
 
 std::string grade_kit_dir() {
-  std::error_code ec;
-  const fs::path self = fs::read_symlink("/proc/self/exe", ec);
-  return ((ec ? fs::current_path() : self.parent_path()) / "grade-kit").string();
+  return (fs::path(build_dir()) / "grade-kit").string();
 }
 
 std::string first_build_error(const std::string& log, int max_lines, const std::string& in_file) {

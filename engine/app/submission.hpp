@@ -46,7 +46,11 @@ SubmissionBuild build_submission(const std::string& submission_dir, const std::s
 // program is in) when it is one. Returns "" or why it failed.
 std::string update_grade_kit(double timeout);
 
-// The build kit generated next to the running clothlab: <dir of clothlab>/grade-kit.
+// The build folder the running program belongs to: the folder of clothlab (and of the grading
+// binaries), which is also the one above student-programs/, where the student programs live.
+std::string build_dir();
+
+// The build kit generated next to the running clothlab: <build folder>/grade-kit.
 std::string grade_kit_dir();
 
 // The first compiler or linker error in a build log ("exercises/01_x.cpp:12:5: error: ..."),

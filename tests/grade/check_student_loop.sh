@@ -57,8 +57,11 @@ grep -Eq '^ex02\.1 +6 / 6 +6 / 6 +done' <<<"$out" || die "ex02 was not graded be
 
 echo "== hidden cases: out of the student's grade and list, in with --hidden"
 if [[ -d $source_dir/tests/grade-hidden ]]; then
-  grade --list | grep -q 'hidden:' && die "--list shows hidden cases without --hidden"
-  grade --list --hidden | grep -q 'hidden:' || die "--list --hidden does not show the hidden cases"
+  # (Read whole first: grep -q would end the pipe early.)
+  list=$(grade --list)
+  grep -q 'hidden:' <<<"$list" && die "--list shows hidden cases without --hidden"
+  list=$(grade --list --hidden)
+  grep -q 'hidden:' <<<"$list" || die "--list --hidden does not show the hidden cases"
 fi
 
 echo "== watch: graded at the start, and again when the file is saved"
