@@ -6,6 +6,8 @@
 // watch a scene run on your code with
 //   ./build/clothlab-student run lessons/01-particles-and-euler/projectile.toml
 // Every symbol is explained in lessons/01-particles-and-euler/README.md.
+// Nothing needs rebuilding by hand: the grader, and each student program before it runs,
+// compiles what you saved first.
 #include "clothlab/euler.hpp"
 #include "clothlab/gravitation.hpp"
 #include "clothlab/gravity.hpp"

@@ -6,6 +6,8 @@
 // Watch a cloth hang on your springs with
 //   ./build/clothlab-student run lessons/02-spring-dampers/hanging-cloth.toml
 // Every symbol is explained in lessons/02-spring-dampers/README.md.
+// Nothing needs rebuilding by hand: the grader, and each student program before it runs,
+// compiles what you saved first.
 #include "clothlab/not_implemented.hpp"
 #include "clothlab/spring_damper.hpp"
 

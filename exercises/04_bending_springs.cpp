@@ -6,6 +6,8 @@
 // Compare a sheet with and without bending on your code with
 //   ./build/clothlab-student run lessons/04-bending-springs/drape-stiff.toml
 // Every symbol is explained in lessons/04-bending-springs/README.md.
+// Nothing needs rebuilding by hand: the grader, and each student program before it runs,
+// compiles what you saved first.
 #include "clothlab/cloth.hpp"
 #include "clothlab/not_implemented.hpp"
 

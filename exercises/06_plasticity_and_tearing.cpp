@@ -6,6 +6,8 @@
 // Tear a sheet on your code with
 //   ./build/clothlab-student run lessons/06-plasticity-and-tearing/tearing-sheet.toml
 // Every symbol is explained in lessons/06-plasticity-and-tearing/README.md.
+// Nothing needs rebuilding by hand: the grader, and each student program before it runs,
+// compiles what you saved first.
 #include <algorithm>
 #include <cmath>
 

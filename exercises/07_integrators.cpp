@@ -6,6 +6,8 @@
 // watch a scene run on your code with
 //   ./build/clothlab-student run lessons/07-integrators/pendulum-cloth.toml
 // Every symbol is explained in lessons/07-integrators/README.md.
+// Nothing needs rebuilding by hand: the grader, and each student program before it runs,
+// compiles what you saved first.
 #include "clothlab/not_implemented.hpp"
 #include "clothlab/runge_kutta.hpp"
 

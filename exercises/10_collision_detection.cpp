@@ -6,6 +6,8 @@
 // watch a towel fold over a line on your code with
 //   ./build/clothlab-student run lessons/10-collision-detection/towel-on-a-line.toml
 // Every symbol is explained in lessons/10-collision-detection/README.md.
+// Nothing needs rebuilding by hand: the grader, and each student program before it runs,
+// compiles what you saved first.
 #include <cmath>
 #include <cstdint>
 

@@ -6,6 +6,8 @@
 // Watch a flag in the wind on your code with
 //   ./build/clothlab-student run lessons/03-aerodynamics/flag.toml
 // Every symbol is explained in lessons/03-aerodynamics/README.md.
+// Nothing needs rebuilding by hand: the grader, and each student program before it runs,
+// compiles what you saved first.
 #include "clothlab/aerodynamics.hpp"
 #include "clothlab/not_implemented.hpp"
 

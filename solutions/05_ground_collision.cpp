@@ -6,6 +6,8 @@
 // Drop a cloth on the floor on your code with
 //   ./build/clothlab-student run lessons/05-ground-collision/cloth-on-floor.toml
 // Every symbol is explained in lessons/05-ground-collision/README.md.
+// Nothing needs rebuilding by hand: the grader, and each student program before it runs,
+// compiles what you saved first.
 #include "clothlab/ground_collision.hpp"
 #include "clothlab/not_implemented.hpp"
 

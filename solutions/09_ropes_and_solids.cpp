@@ -6,6 +6,8 @@
 // watch a cloth held taut by your code with
 //   ./build/clothlab-student run lessons/09-ropes-and-solids/taut-cloth.toml
 // Every symbol is explained in lessons/09-ropes-and-solids/README.md.
+// Nothing needs rebuilding by hand: the grader, and each student program before it runs,
+// compiles what you saved first.
 #include <cmath>
 
 #include "clothlab/not_implemented.hpp"

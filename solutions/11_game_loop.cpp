@@ -6,6 +6,8 @@
 // watch a cloth driven frame by frame through your accumulator with
 //   ./build/lesson11-student
 // Every symbol is explained in lessons/11-game-loop/README.md.
+// Nothing needs rebuilding by hand: the grader, and each student program before it runs,
+// compiles what you saved first.
 #include <algorithm>
 #include <cmath>
 

@@ -72,16 +72,31 @@ grep -q "ex01.1 is not implemented yet" "$work/stub-run.log" ||
   die "the stopped scene does not name ex01.1: $(cat "$work/stub-run.log")"
 
 say "with every exercise solved: full marks, and the scenes run on the student's code"
+# Nothing is rebuilt by hand: the grader builds the exercises as saved, and each student
+# program's launcher brings the program up to date before it runs.
 cp "$source_dir"/solutions/[0-9][0-9]_*.cpp "$release/exercises/"
-cmake --build "$release/build" --parallel "$jobs" --target clothlab clothlab-student \
-  lesson02-student >"$work/rebuild.log" 2>&1 || {
-  tail -50 "$work/rebuild.log"
-  die "the solved release does not build"
-}
 (cd "$release" && NO_COLOR=1 ./build/clothlab grade --require-full)
 (cd "$release" && ./build/clothlab-student run lessons/02-spring-dampers/hanging-cloth.toml \
   --out "$work/solved-run")
 (cd "$release" && ./build/lesson02-student >/dev/null)
+
+say "an edit that does not compile: no stale grade, no stale program"
+ex01=$release/exercises/01_particles_and_euler.cpp
+sed -i 's/return m \* g;/return m * g/' "$ex01"
+grep -q 'return m \* g$' "$ex01" || die "the planted typo is not in $ex01"
+out=$(cd "$release" && NO_COLOR=1 ./build/clothlab grade) || true
+grep -Eq '^ex01\.1 +0 / 2 +0 / 2 +not compiled' <<<"$out" || die "a broken ex01 was graded: $out"
+grep -Eq 'exercises/01_particles_and_euler\.cpp:[0-9]+:[0-9]+: error:' <<<"$out" ||
+  die "the grader does not show the compiler's error: $out"
+grep -Eq '^ex02\.1 +[0-9]+ / [0-9]+ +[0-9]+ / [0-9]+ +done' <<<"$out" ||
+  die "ex02 was not graded beside the broken ex01: $out"
+if (cd "$release" && ./build/lesson01-student) >"$work/stale.log" 2>&1; then
+  die "lesson01-student ran code older than the broken exercise file"
+fi
+grep -q 'nothing was run' "$work/stale.log" || die "lesson01-student does not say why: $(cat "$work/stale.log")"
+cp "$source_dir"/solutions/01_particles_and_euler.cpp "$ex01"
+(cd "$release" && NO_COLOR=1 ./build/clothlab grade --exercise ex01 --require-full)
+(cd "$release" && ./build/lesson01-student >/dev/null)
 
 if [[ $gradescope -eq 1 ]]; then
   say "the Gradescope autograder: setup.sh, then run_autograder on a submission"

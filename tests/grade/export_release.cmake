@@ -60,7 +60,9 @@ file(WRITE ${tree}/README.md
 "> **Student release.** This copy has no `solutions/` and no hidden grading tests: every
 > program here, `clothlab` as well as `clothlab-student`, runs on your `exercises/`, so a scene
 > runs once the exercises its effects need are done (until then it stops and names the
-> exercise). `./build/clothlab grade` scores your work; `--impl reference` is not available.
+> exercise). `./build/clothlab grade` scores your work as saved; `--impl reference` is not
+> available. `./build/clothlab-student` and `./build/lessonNN-student` bring themselves up to
+> date before they run; `./build/clothlab` runs what `cmake --build build` last built.
 
 ${readme}")
 

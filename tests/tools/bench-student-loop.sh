@@ -5,7 +5,9 @@
 #      graded exercise (`clothlab grade --exercise ex01.1`);
 #   2. the loop: an exercise file edited (solved, made wrong, broken, mended), then graded, for
 #      one exercise and for all of them, with nothing rebuilt by hand;
-#   3. what the student build gives up for it: `clothlab bench speed` on a 64 x 64 cloth, the
+#   3. a student program: its first run (which builds it), then an edit and a run (its launcher
+#      rebuilds it first);
+#   4. what the student build gives up for it: `clothlab bench speed` on a 64 x 64 cloth, the
 #      reference build and the student build (its exercises solved) taking turns in one run.
 # Prints each figure as it is measured, then a summary. Needs the packages of the Quick start;
 # takes a few minutes on two cores. A benchmark, not a test: nothing here passes or fails on time.
@@ -83,10 +85,24 @@ summary+=("$(printf 'edit, then grade every exercise: median %.2f s (most %.2f s
 summary+=("$(printf 'a file that does not compile, then grade every exercise: median %.2f s' \
   "$(median "${broken[@]}")")")
 
-echo "== 3. the student build's steps against the reference build's (64 x 64 cloth)"
+echo "== 3. the student programs: built on demand, brought up to date by their launchers"
+timed "first run of ./build/clothlab-student (builds it)" ./build/clothlab-student --help
+summary+=("$(printf 'the first run of clothlab-student, which builds it: %.0f s' "$last")")
+launch=()
+for round in $(seq "$repeats"); do
+  cp solutions/01_particles_and_euler.cpp "$ex01"
+  timed "round $round: ex01 solved, ./build/clothlab-student --help" ./build/clothlab-student --help
+  launch+=("$last")
+  cp "$work/01.stub" "$ex01"
+  timed "round $round: back to the stub, ./build/clothlab-student --help" ./build/clothlab-student --help
+  launch+=("$last")
+done
+summary+=("$(printf 'edit one exercise file, then run clothlab-student (rebuilt first): median %.2f s (most %.2f s)' \
+  "$(median "${launch[@]}")" "$(printf '%s\n' "${launch[@]}" | sort -g | tail -1)")")
+
+echo "== 4. the student build's steps against the reference build's (64 x 64 cloth)"
 cp solutions/[0-9][0-9]_*.cpp exercises/
 timed "build clothlab-student on the solved exercises" cmake --build build --target clothlab-student
-summary+=("$(printf 'relinking clothlab-student after the edit: %.0f s' "$last")")
 NO_COLOR=1 ./build/clothlab bench speed --sizes 64 --variants reference,student --threads 1 \
   --repeats 5 | tee "$work/speed.txt"
 ref=$(awk '$3 == "reference" && $4 == "1" {print $5; exit}' "$work/speed.txt")
