@@ -26,6 +26,7 @@
 #include <cmath>
 #include <csignal>
 #include <cstdlib>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
@@ -121,6 +122,49 @@ SignalInfo crash_signal(int sig, const std::string& reported) {
     if (reported.starts_with(s.name)) return s;
   }
   return {0, "another signal", ""};
+}
+
+// JSON and XML want valid UTF-8; a crashing case can print anything.
+std::string valid_utf8(const std::string& in) {
+  std::string out;
+  for (std::size_t i = 0; i < in.size();) {
+    const auto b = static_cast<unsigned char>(in[i]);
+    const std::size_t n = b < 0x80           ? 1
+                          : (b >> 5) == 0x6  ? 2
+                          : (b >> 4) == 0xE  ? 3
+                          : (b >> 3) == 0x1E ? 4
+                                             : 0;
+    bool ok = n > 0 && i + n <= in.size();
+    for (std::size_t k = 1; ok && k < n; ++k)
+      ok = (static_cast<unsigned char>(in[i + k]) >> 6) == 0x2;
+    out += ok ? in.substr(i, n) : "?";
+    i += ok ? n : 1;
+  }
+  return out;
+}
+
+// Text a submission wrote (its messages, its output, the compiler's quotes of its code) made
+// safe for a terminal: valid UTF-8, with control characters shown in caret notation ("^[" for
+// an escape), so that it cannot move the cursor, clear the screen or draw a fake result.
+std::string printable(const std::string& text) {
+  const std::string in = valid_utf8(text);
+  std::string out;
+  for (std::size_t i = 0; i < in.size(); ++i) {
+    const auto b = static_cast<unsigned char>(in[i]);
+    if (b == '\n' || b == '\t') {
+      out += in[i];
+    } else if (b < 0x20 || b == 0x7f) {
+      out += '^';
+      out += static_cast<char>(b == 0x7f ? '?' : b + 64);
+    } else if (b == 0xc2 && i + 1 < in.size() && static_cast<unsigned char>(in[i + 1]) >= 0x80 &&
+               static_cast<unsigned char>(in[i + 1]) <= 0x9f) {
+      out += "^?";  // a C1 control (U+0080 to U+009F), which some terminals obey
+      ++i;
+    } else {
+      out += in[i];
+    }
+  }
+  return out;
 }
 
 // --- The line protocol ------------------------------------------------------------------------
@@ -338,6 +382,9 @@ void judge(Case& c, const ProcessResult& run, const std::string& binary, double 
                                : c.message;
   c.diagnosis = line.substr(0, line.find('\n'));
   if (c.diagnosis.size() > 160) c.diagnosis = c.diagnosis.substr(0, 157) + "...";
+  c.message = printable(c.message);
+  c.diagnosis = printable(c.diagnosis);
+  c.output = printable(c.output);
 }
 
 // --- Listing and running cases ----------------------------------------------------------------
@@ -409,10 +456,19 @@ void run_case(const std::string& binary, Case& c, double timeout) {
     filter += (ch == '*' || ch == '?') ? std::string("?")
               : ch == '\\'             ? std::string("\\\\")
                                        : std::string(1, ch);
+  // A case may not take the machine: its memory, processor time and files are bounded, for every
+  // process it starts. (AddressSanitizer reserves terabytes of address space, so a sanitized
+  // grader leaves the memory bound to the sanitizer.)
+  ProcessLimits limits;
+#ifndef __SANITIZE_ADDRESS__
+  limits.memory_bytes = std::size_t{4} << 30;
+#endif
+  limits.cpu_seconds = timeout + 1;
+  limits.file_bytes = std::size_t{64} << 20;
   const auto start = Clock::now();
   const ProcessResult run = run_process({binary, "--reporters=clothlab", "--test-case=" + filter,
                                          "--case-sensitive=true", "--no-breaks=true"},
-                                        timeout);
+                                        timeout, limits);
   c.seconds = std::chrono::duration<double>(Clock::now() - start).count();
   judge(c, run, binary, timeout);
 }
@@ -512,25 +568,6 @@ std::string summary(const std::vector<Case>& cases, bool colour) {
   return s;
 }
 
-// JSON and XML want valid UTF-8; a crashing case can print anything.
-std::string valid_utf8(const std::string& in) {
-  std::string out;
-  for (std::size_t i = 0; i < in.size();) {
-    const auto b = static_cast<unsigned char>(in[i]);
-    const std::size_t n = b < 0x80           ? 1
-                          : (b >> 5) == 0x6  ? 2
-                          : (b >> 4) == 0xE  ? 3
-                          : (b >> 3) == 0x1E ? 4
-                                             : 0;
-    bool ok = n > 0 && i + n <= in.size();
-    for (std::size_t k = 1; ok && k < n; ++k)
-      ok = (static_cast<unsigned char>(in[i + k]) >> 6) == 0x2;
-    out += ok ? in.substr(i, n) : "?";
-    i += ok ? n : 1;
-  }
-  return out;
-}
-
 // JSON text of a report: invalid UTF-8 from a test's output replaced first.
 std::string json_text(const std::string& text) {
   return clothlab::json_string(valid_utf8(text));
@@ -569,16 +606,49 @@ std::string case_report(const Case& c, bool with_output) {
 }
 
 // Written to PATH.tmp then renamed, so a reader never sees half a file.
-void write_file(const std::string& path, const std::string& text) {
-  const std::string tmp = path + ".tmp";
-  {
-    std::ofstream out(tmp, std::ios::binary);
-    out << text;
-    if (!out.flush()) fail(2, "cannot write " + tmp);
-  }
+// A report goes only to a new file or over a regular one: never through a symbolic link, and
+// never onto a device (as root, `--results /dev/null` would otherwise replace /dev/null).
+void check_report_path(const std::string& option, const std::string& path) {
+  if (path.empty()) return;
   std::error_code ec;
+  const fs::file_status status = fs::symlink_status(path, ec);
+  if (ec || !fs::exists(status)) return;
+  if (fs::is_symlink(status))
+    fail(2, fmt::format("{} {}: is a symbolic link; give the path of a new or a regular file",
+                        option, path));
+  if (!fs::is_regular_file(status))
+    fail(2, fmt::format("{} {}: is not a regular file (a device or a folder?); give the path of a "
+                        "new or a regular file",
+                        option, path));
+}
+
+// Written to a new file beside `path` (created here, so no one else's file or link is
+// written through), then renamed over it: a reader never sees half a file.
+void write_file(const std::string& path, const std::string& text) {
+  std::error_code ec;
+  const fs::file_status status = fs::symlink_status(path, ec);
+  if (!ec && fs::exists(status) && !fs::is_regular_file(status))
+    fail(2, "not writing " + path + ": it is no longer a regular file");
+  const std::string tmp = fmt::format("{}.{}.tmp", path, getpid());
+  const int fd = open(tmp.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_NOFOLLOW | O_CLOEXEC, 0644);
+  if (fd < 0) fail(2, "cannot write " + tmp + ": " + std::strerror(errno));
+  std::size_t written = 0;
+  while (written < text.size()) {
+    const ssize_t n = write(fd, text.data() + written, text.size() - written);
+    if (n < 0 && errno == EINTR) continue;
+    if (n <= 0) {
+      close(fd);
+      fs::remove(tmp, ec);
+      fail(2, "cannot write " + tmp + ": " + std::strerror(errno));
+    }
+    written += static_cast<std::size_t>(n);
+  }
+  close(fd);
   fs::rename(tmp, path, ec);
-  if (ec) fail(2, "cannot write " + path + ": " + ec.message());
+  if (ec) {
+    fs::remove(tmp, ec);
+    fail(2, "cannot write " + path + ": " + ec.message());
+  }
 }
 
 std::string gradescope_json(const std::vector<Case>& cases, double seconds,
@@ -767,8 +837,10 @@ void print_points_table(const std::vector<Case>& cases) {
 std::string submission_notes(const SubmissionBuild& b) {
   auto names = [](const std::vector<std::string>& files) {
     std::string s;
-    for (const std::string& f : files)
-      s += (s.empty() ? "" : ", ") + f;
+    for (const std::string& f : files) {
+      if (!s.empty()) s += ", ";
+      s += printable(f);  // names the submission chose
+    }
     return s;
   };
   std::string s;
@@ -776,6 +848,7 @@ std::string submission_notes(const SubmissionBuild& b) {
   if (!b.missing.empty())
     s += "Not in the submission (graded on the shipped stub): " + names(b.missing) + "\n";
   if (!b.ignored.empty()) s += "Ignored (not an exercise file): " + names(b.ignored) + "\n";
+  if (!b.refused.empty()) s += "Refused (graded on the shipped stub): " + names(b.refused) + "\n";
   if (!b.built) s += "\nThe submission does not compile:\n" + indent(b.first_error, "  ") + "\n";
   return s + "\n";
 }
@@ -798,7 +871,8 @@ bool in_file(const Case& c, const std::string& file) {
 // The student's own grading: exercises/ built afresh with the kit (only what changed is
 // recompiled), a file that does not compile standing aside for its stub. Returns the binary to
 // grade, or "" when nothing could be built; marks the cases that cannot be graded.
-std::string build_own(const Options& o, std::vector<Case>& cases, std::string& notes, bool colour) {
+std::string build_own(const Options& o, std::vector<Case>& cases, std::string& notes, bool colour,
+                      std::shared_ptr<void>& hold) {
   const std::string dir =
       o.exercises.empty() ? (fs::path(CLOTHLAB_SOURCE_DIR) / "exercises").string() : o.exercises;
   if (colour) fmt::print("building your exercises ...");
@@ -811,8 +885,12 @@ std::string build_own(const Options& o, std::vector<Case>& cases, std::string& n
     fail(2, e.what());
   }
   if (colour) fmt::print("\r\033[K");
+  hold = build.hold;  // the scratch folder stays this grader's while the binary is graded
+  for (const std::string& why : build.refused)
+    notes += "Refused, graded on its shipped stub: exercises/" + printable(why) + "\n";
   if (!build.built) {
     if (g_interrupted) return "";
+    build.first_error = printable(build.first_error);
     notes += "Your exercises do not build:\n" + indent(build.first_error, "  ") + "\n\n";
     for (Case& c : cases) {
       c.done = true;
@@ -823,7 +901,8 @@ std::string build_own(const Options& o, std::vector<Case>& cases, std::string& n
     }
     return "";
   }
-  for (const SubmissionBuild::Broken& broken : build.broken) {
+  for (SubmissionBuild::Broken& broken : build.broken) {
+    broken.error = printable(broken.error);
     for (Case& c : cases) {
       if (!in_file(c, broken.name)) continue;
       c.done = true;
@@ -843,6 +922,10 @@ void grade(const Options& o) {
   // of a binary older than the files.
   const bool own = !submission && o.binary.empty() && o.impl == "student";
   const bool grading = !o.list && o.classroom.empty();
+  check_report_path("--results", o.results);
+  check_report_path("--junit", o.junit);
+  check_report_path("--classroom", o.classroom);
+  adopt_orphans();  // a process a case leaves behind is handed to the grader, which ends it
   if ((submission || own) &&
       (grading || !fs::exists(fs::path(grade_kit_dir()).parent_path() / "grade-stubs"))) {
     const std::string why = update_grade_kit(o.build_timeout);
@@ -883,6 +966,7 @@ void grade(const Options& o) {
   auto elapsed = [&] { return std::chrono::duration<double>(Clock::now() - start).count(); };
   std::string notes;
   bool compiled = true;
+  std::shared_ptr<void> hold;  // the scratch folder's lock, while its binary is graded
   if (submission) {
     notes = "Submission: " + o.submission + "\n";
     write_reports(o, cases, elapsed(), notes);  // so even an interrupted build leaves results
@@ -896,6 +980,8 @@ void grade(const Options& o) {
       fail(2, e.what());
     }
     if (colour) fmt::print("\r\033[K");
+    hold = build.hold;
+    build.first_error = printable(build.first_error);
     notes += submission_notes(build);
     fmt::print("{}", notes);
     compiled = build.built;
@@ -911,7 +997,7 @@ void grade(const Options& o) {
     }
   }
   if (own) {
-    binary = build_own(o, cases, notes, colour);
+    binary = build_own(o, cases, notes, colour, hold);
     compiled = !binary.empty();
     fmt::print("{}", notes);
   }

@@ -38,9 +38,29 @@ struct ProcessResult {
   bool interrupted = false;
 };
 
-constexpr std::size_t kMaxOutput = 1 << 20;  // keep at most 1 MiB of a chatty child's output
+// At most 1 MiB of a chatty child's own output is kept. Past that, only the lines of the grading
+// binaries' protocol (tagged "@clothlab\t", up to kMaxEvents bytes) are kept, so that an honest
+// case that prints a lot is still judged on what its reporter said.
+constexpr std::size_t kMaxOutput = 1 << 20;
+constexpr std::size_t kMaxEvents = 4 << 20;
+
+// Limits set on the child (setrlimit) before it runs, inherited by whatever it starts; 0 leaves
+// a limit as it is. A child that passes one is stopped by the kernel: out of memory (an
+// allocation fails), SIGXCPU, or SIGXFSZ.
+struct ProcessLimits {
+  std::size_t memory_bytes = 0;  // address space (RLIMIT_AS)
+  double cpu_seconds = 0;        // processor time (RLIMIT_CPU)
+  std::size_t file_bytes = 0;    // size of any file it writes (RLIMIT_FSIZE)
+};
 
 // Runs args[0] (an absolute path) with args, stdin from /dev/null, for at most timeout [s].
-ProcessResult run_process(const std::vector<std::string>& args, double timeout);
+// Whatever the child started ends with it: its process group is killed when it ends, and so is
+// any process that left the group (setsid) and was handed to this one when its parent died.
+ProcessResult run_process(const std::vector<std::string>& args, double timeout,
+                          const ProcessLimits& limits = {});
+
+// Makes this process the one that orphans of its children are handed to (a "subreaper"), so that
+// run_process can end them. Called once by the grader before it runs anything.
+void adopt_orphans();
 
 }  // namespace clothlab::app

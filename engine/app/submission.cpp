@@ -1,11 +1,15 @@
 // submission.cpp: see submission.hpp.
 #include "app/submission.hpp"
 
+#include <fcntl.h>
+#include <sys/file.h>
 #include <unistd.h>
 
 #include <fmt/core.h>
 
 #include <algorithm>
+#include <cctype>
+#include <cstdint>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
@@ -59,14 +63,154 @@ std::vector<ExerciseFile> kit_exercises(const fs::path& kit) {
   return files;
 }
 
+constexpr std::uintmax_t kMaxFileBytes = 1 << 20;  // an exercise file is a few kilobytes
+
 // Where a submission keeps `name`: at its top, or in an exercises/ folder (a copy of the
-// starter repository). Empty when it has neither.
-fs::path find_in_submission(const fs::path& dir, const std::string& name) {
+// starter repository). Empty when it has neither, or when what it has there is refused: only a
+// regular file inside the submission folder is taken, never a symbolic link (to solutions/, say),
+// a device (/dev/zero), a folder or a file of more than kMaxFileBytes. `why` then says which.
+fs::path find_in_submission(const fs::path& dir, const std::string& name, std::string& why) {
+  std::error_code ec;
+  const fs::path root = fs::weakly_canonical(dir, ec);
   for (const fs::path& candidate : {dir / name, dir / "exercises" / name}) {
-    std::error_code ec;
-    if (fs::is_regular_file(candidate, ec)) return candidate;
+    const fs::file_status status = fs::symlink_status(candidate, ec);
+    if (ec || !fs::exists(status)) continue;
+    if (fs::is_symlink(status)) {
+      why = name + " (a symbolic link)";
+    } else if (!fs::is_regular_file(status)) {
+      why = name + " (not a regular file)";
+    } else if (!fs::weakly_canonical(candidate, ec).string().starts_with(root.string() + "/")) {
+      why = name + " (in a folder that links outside the submission)";
+    } else if (fs::file_size(candidate, ec) > kMaxFileBytes) {
+      why = name + " (larger than 1 MiB)";
+    } else {
+      return candidate;
+    }
+    return {};
   }
   return {};
+}
+
+// Joins the lines a backslash continues and blanks out comments, keeping line numbers: what the
+// preprocessor reads as directives, without their disguises.
+std::string directives_view(const std::string& text) {
+  std::string joined;
+  for (std::size_t i = 0; i < text.size(); ++i) {
+    if (text[i] == '\\' && i + 1 < text.size() && text[i + 1] == '\n') {
+      ++i;
+      joined += ' ';  // (the line number drifts by the joins; the message quotes the text too)
+      continue;
+    }
+    joined += text[i];
+  }
+  std::string out;
+  enum { kCode, kLine, kBlock, kString, kChar } state = kCode;
+  for (std::size_t i = 0; i < joined.size(); ++i) {
+    const char c = joined[i];
+    const char next = i + 1 < joined.size() ? joined[i + 1] : '\0';
+    switch (state) {
+      case kCode:
+        if (c == '/' && next == '/') {
+          state = kLine;
+          out += ' ';
+        } else if (c == '/' && next == '*') {
+          state = kBlock;
+          out += ' ';
+          ++i;
+        } else {
+          if (c == '"') state = kString;
+          if (c == '\'') state = kChar;
+          out += c;
+        }
+        break;
+      case kLine:
+        if (c == '\n') {
+          state = kCode;
+          out += c;
+        }
+        break;
+      case kBlock:
+        if (c == '*' && next == '/') {
+          state = kCode;
+          ++i;
+        } else if (c == '\n') {
+          out += c;
+        }
+        break;
+      case kString:
+      case kChar:
+        out += c;
+        if (c == '\\' && next != '\0') {
+          out += next;
+          ++i;
+        } else if ((state == kString && c == '"') || (state == kChar && c == '\'') || c == '\n') {
+          state = kCode;
+        }
+        break;
+    }
+  }
+  return out;
+}
+
+// Why the exercise file `text` may not be compiled, or "": it may include the standard library's
+// and the engine's headers (<...> or "clothlab/..."), by a name that does not climb out of
+// their folders (no "..", not absolute), and nothing else: not a solution, not a grading test,
+// not /etc/passwd or /dev/zero. The assembler's .incbin, which reads any file into the program,
+// is refused too. (The compiler itself also runs under memory and time limits.)
+std::string include_problem(const std::string& name, const std::string& text) {
+  std::istringstream in(directives_view(text));
+  int number = 0;
+  for (std::string line; std::getline(in, line);) {
+    ++number;
+    const auto where = [&](const std::string& what) {
+      return fmt::format("exercises/{}:{}: error: {}", name, number, what);
+    };
+    std::size_t i = line.find_first_not_of(" \t");
+    if (i == std::string::npos) continue;
+    if (line.find("incbin") != std::string::npos)
+      return where("'.incbin' reads a file into the program; an exercise may not use it");
+    if (line.compare(i, 1, "#") == 0) {
+      i += 1;
+    } else if (line.compare(i, 2, "%:") == 0) {
+      i += 2;
+    } else {
+      continue;
+    }
+    i = line.find_first_not_of(" \t", i);
+    if (i == std::string::npos) continue;
+    std::size_t end = i;
+    while (end < line.size() &&
+           (std::isalnum(static_cast<unsigned char>(line[end])) || line[end] == '_'))
+      ++end;
+    const std::string directive = line.substr(i, end - i);
+    if (directive != "include" && directive != "include_next" && directive != "import" &&
+        directive != "embed")
+      continue;
+    const std::size_t open = line.find_first_not_of(" \t", end);
+    const char opener = open == std::string::npos ? '\0' : line[open];
+    const char closer = opener == '<' ? '>' : opener == '"' ? '"' : '\0';
+    const std::size_t close = closer == '\0' ? std::string::npos : line.find(closer, open + 1);
+    if (directive != "include" || close == std::string::npos) {
+      return where(
+          fmt::format("'#{}' with what follows it is not allowed in an exercise file; "
+                      "include a header by name: #include <vector> or #include "
+                      "\"clothlab/...\"",
+                      directive));
+    }
+    const std::string header = line.substr(open + 1, close - open - 1);
+    const bool climbs = header.empty() || header.front() == '/' ||
+                        header.find("..") != std::string::npos ||
+                        header.find('\\') != std::string::npos;
+    const bool allowed = opener == '<' || header.starts_with("clothlab/");
+    if (climbs || !allowed) {
+      return where(fmt::format(
+          "#include {}{}{} is outside the standard library and the engine's headers; an "
+          "exercise may include <...> headers and \"clothlab/...\" ones, by a name without "
+          "\"..\"",
+          opener, header, closer));
+    }
+  }
+  return "";
 }
 
 std::string replace_all(std::string text, const std::string& from, const std::string& to) {
@@ -182,7 +326,30 @@ SubmissionBuild build_submission(const std::string& submission_dir, const std::s
     throw std::runtime_error("the submission folder " + submission_dir + " does not exist");
 
   SubmissionBuild result;
-  const fs::path scratch = fs::absolute(scratch_dir);
+  fs::path scratch = fs::absolute(scratch_dir);
+  fs::create_directories(scratch);
+  const auto lock = [](const fs::path& dir, bool wait) {
+    const int fd = open((dir / ".lock").c_str(), O_RDWR | O_CREAT | O_CLOEXEC | O_NOFOLLOW, 0644);
+    if (fd >= 0 && flock(fd, wait ? LOCK_EX : LOCK_EX | LOCK_NB) == 0) return fd;
+    if (fd >= 0) close(fd);
+    return -1;
+  };
+  int fd = lock(scratch, false);
+  bool own_folder = false;
+  if (fd < 0) {
+    // Another grader builds here: this one takes a folder of its own, so that neither grades
+    // the other's binary.
+    scratch = scratch.string() + "-" + std::to_string(getpid());
+    fs::remove_all(scratch, ec);
+    fs::create_directories(scratch);
+    fd = lock(scratch, true);
+    own_folder = true;
+  }
+  result.hold = std::shared_ptr<void>(nullptr, [fd, scratch, own_folder](void*) {
+    if (fd >= 0) close(fd);
+    std::error_code ignored;
+    if (own_folder) fs::remove_all(scratch, ignored);
+  });
   const fs::path exercises = scratch / "exercises";
   const fs::path build = scratch / "build";
   fs::create_directories(exercises);
@@ -190,14 +357,26 @@ SubmissionBuild build_submission(const std::string& submission_dir, const std::s
 
   // The submission's files over the stubs, file by file.
   const std::vector<ExerciseFile> files = kit_exercises(kit);
+  std::string refused_include;  // the first file that includes what it may not
   for (const ExerciseFile& file : files) {
-    const fs::path found = find_in_submission(from, file.name);
+    std::string why;
+    const fs::path found = find_in_submission(from, file.name, why);
+    if (!why.empty()) result.refused.push_back(why);
     if (found.empty()) {
-      result.missing.push_back(file.name);
+      if (why.empty()) result.missing.push_back(file.name);
+      take_file(file.stub, exercises / file.name, file.stub);
+      continue;
+    }
+    result.taken.push_back(file.name);
+    const std::string problem = include_problem(file.name, read_text(found));
+    if (problem.empty()) {
+      take_file(found, exercises / file.name, file.stub);
+    } else if (stub_broken_files) {
+      result.broken.push_back({file.name, problem});
       take_file(file.stub, exercises / file.name, file.stub);
     } else {
-      result.taken.push_back(file.name);
-      take_file(found, exercises / file.name, file.stub);
+      if (refused_include.empty()) refused_include = problem;
+      take_file(file.stub, exercises / file.name, file.stub);
     }
   }
   for (const fs::path& dir : {from, from / "exercises"}) {
@@ -208,6 +387,10 @@ SubmissionBuild build_submission(const std::string& submission_dir, const std::s
                                      [&](const ExerciseFile& f) { return f.name == name; });
       if (entry.path().extension() == ".cpp" && !known) result.ignored.push_back(name);
     }
+  }
+  if (!refused_include.empty()) {
+    result.first_error = refused_include;  // nothing is compiled
+    return result;
   }
 
   // A binary left from the submission graded before must never be graded for this one.
@@ -243,7 +426,13 @@ SubmissionBuild build_submission(const std::string& submission_dir, const std::s
     for (const std::string& arg : keep_going_args())
       args.push_back(arg);
   }
-  ProcessResult compile = run_process(args, timeout);
+  // The compiler reads what the submission says: bounded like a case, so that no file it is
+  // pointed at can make it take the machine.
+  ProcessLimits limits;
+  limits.memory_bytes = std::size_t{4} << 30;
+  limits.cpu_seconds = timeout;
+  limits.file_bytes = std::size_t{1} << 30;
+  ProcessResult compile = run_process(args, timeout, limits);
   result.log += shown(compile.output);
 
   // The student's loop: a file that does not compile gives way to its stub, and the build is
@@ -258,7 +447,7 @@ SubmissionBuild build_submission(const std::string& submission_dir, const std::s
       take_file(file.stub, exercises / file.name, file.stub);
     }
     if (!result.broken.empty()) {
-      compile = run_process(args, timeout);
+      compile = run_process(args, timeout, limits);
       result.log += shown(compile.output);
     }
   }

@@ -8,6 +8,7 @@
 // of the submission runs here: it is only compiled.
 #pragma once
 
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -21,6 +22,8 @@ struct SubmissionBuild {
   std::vector<std::string> taken;    // exercise files taken from the submission
   std::vector<std::string> missing;  // exercise files it lacks (graded on the shipped stub)
   std::vector<std::string> ignored;  // other .cpp files in it, left out
+  // Exercise files refused, each with why ("01_x.cpp (a symbolic link)"): graded on the stub.
+  std::vector<std::string> refused;
   // With stub_broken_files: the exercise files that did not compile, each with the compiler's
   // first error; the binary holds their shipped stubs instead.
   struct Broken {
@@ -28,6 +31,9 @@ struct SubmissionBuild {
     std::string error;  // "exercises/01_particles_and_euler.cpp:12:5: error: ..."
   };
   std::vector<Broken> broken;
+  // The scratch folder's lock, held as long as this is kept: no other grader builds there
+  // meanwhile. (A grader that finds it held builds in a folder of its own, removed with this.)
+  std::shared_ptr<void> hold;
 };
 
 // Builds the grading binary of the submission in `submission_dir` (exercise files named as in

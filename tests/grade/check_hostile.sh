@@ -1,0 +1,165 @@
+#!/usr/bin/env bash
+# check_hostile.sh CLOTHLAB SOURCE WORK_DIR: `clothlab grade --submission` on hostile
+# submissions, one per kind of attack the grader now holds against (README, "The threat model"),
+# and on honest ones that look odd. Each is graded on lesson 01 (14 points) and must score no more
+# than its honest part earns, leave a valid report, change nothing outside its scratch folder and
+# leave no process behind; the honest chatty one must score full marks.
+set -euo pipefail
+clothlab=$1
+source_dir=$2
+work=$3
+rm -rf "$work"
+mkdir -p "$work"
+problems=()
+problem() { problems+=("$*"); }
+solution=$source_dir/solutions/01_particles_and_euler.cpp
+name=01_particles_and_euler.cpp
+tree_sum() { find "$source_dir/exercises" "$source_dir/solutions" "$source_dir/tests/grade" -type f -print0 | sort -z | xargs -0 sha256sum | sha256sum; }
+sums_before=$(tree_sum)
+
+# The score in a results.json, read by CMake's JSON parser (which also proves the file valid).
+cat >"$work/score.cmake" <<'EOF'
+file(READ ${FILE} json)
+string(JSON score ERROR_VARIABLE bad GET "${json}" score)
+if(bad)
+  message(FATAL_ERROR "not valid JSON: ${bad}")
+endif()
+message("${score}")
+EOF
+score_of() { cmake -DFILE="$1" -P "$work/score.cmake" 2>&1; }
+
+# grade NAME [ARGS...]: grades $work/NAME on ex01, output in $work/NAME.out, score in $score.
+grade() {
+  local sub=$1
+  shift
+  set +e
+  NO_COLOR=1 "$clothlab" grade --submission "$work/$sub" --scratch "$work/scratch" \
+    --results "$work/$sub.json" --exercise ex01 --timeout 5 "$@" >"$work/$sub.out" 2>&1
+  code=$?
+  set -e
+  score=$(score_of "$work/$sub.json")
+  echo "--- $sub: exit $code, score $score"
+  cat "$work/$sub.out"
+}
+# expect NAME MAX: scored at most MAX, and a valid report.
+expect_at_most() {
+  [[ $score =~ ^[0-9]+$ ]] || {
+    problem "$1: no valid results.json ($score)"
+    return
+  }
+  ((score <= $2)) || problem "$1: scored $score, more than the $2 its code earns"
+}
+# plant NAME FILE-TEXT: a submission holding one exercise file.
+plant() {
+  mkdir -p "$work/$1"
+  printf '%s\n' "$2" >"$work/$1/$name"
+}
+# patch TEXT: the solution with the gravity kernel's body replaced by TEXT, and PREAMBLE on top.
+patched() {
+  local preamble=$1 body=$2
+  printf '%s\n' "$preamble"
+  sed "s|  return m \* g;|$body|" "$solution"
+}
+
+# --- files that are not the submission's own -------------------------------------------------
+mkdir -p "$work/symlink" "$work/linked-folder"
+ln -s "$solution" "$work/symlink/$name"
+ln -s "$source_dir/solutions" "$work/linked-folder/exercises"
+for sub in symlink linked-folder; do
+  grade "$sub"
+  expect_at_most "$sub" 0
+  grep -q "Refused (graded on the shipped stub): $name" "$work/$sub.out" ||
+    problem "$sub: the refused file is not named"
+done
+
+# --- includes outside the submission and the engine's headers --------------------------------
+plant include-relative "#include \"../../../solutions/$name\""
+plant include-absolute "#include \"$solution\""
+plant include-passwd '#include "/etc/passwd"'
+plant include-device '#include "/dev/zero"'
+plant include-angle "#include <../../../../../../../$solution>"
+plant include-disguised "$(printf '#\\\ninclude "/etc/passwd"')"
+plant include-commented '# /* a comment */ include "/etc/passwd"'
+plant include-computed "$(printf '#define WHERE "/etc/passwd"\n#include WHERE')"
+plant incbin 'asm(".incbin \"/etc/passwd\"");'
+for sub in include-relative include-absolute include-passwd include-device include-angle \
+  include-disguised include-commented include-computed incbin; do
+  start=$SECONDS
+  grade "$sub"
+  expect_at_most "$sub" 0
+  grep -q "exercises/$name:[0-9]*: error:" "$work/$sub.out" ||
+    problem "$sub: the refusal does not name the file and line"
+  grep -q 'root:' "$work/$sub.out" && problem "$sub: the output quotes /etc/passwd"
+  ((SECONDS - start < 120)) || problem "$sub: took $((SECONDS - start)) s"
+done
+
+# --- text that would drive the instructor's terminal -------------------------------------------
+mkdir -p "$work/escapes"
+patched '#include <stdexcept>' '  throw std::runtime_error("\\x1b[2J\\x1b[Hex01.1  2 \/ 2  done\\x07");' \
+  >"$work/escapes/$name"
+grade escapes
+expect_at_most escapes 12
+if grep -q $'\x1b' "$work/escapes.out"; then problem "escapes: an escape character reached the terminal"; fi
+grep -q '\^\[\[2J' "$work/escapes.out" || problem "escapes: the escape is not shown as ^["
+
+# --- an honest, correct submission that prints a lot -------------------------------------------
+mkdir -p "$work/chatty"
+patched '#include <cstdio>
+#include <string>' '  { const std::string s(3 << 20, '"'"'x'"'"'); std::fputs(s.c_str(), stdout); } return m * g;' \
+  >"$work/chatty/$name"
+grade chatty
+[[ $score == 14 ]] || problem "chatty: an honest submission that prints 3 MiB scored $score of 14"
+
+# --- a process that leaves the case's process group --------------------------------------------
+mkdir -p "$work/orphan"
+marker=61.$$
+patched '#include <unistd.h>' "  if (fork() == 0) { setsid(); if (fork() == 0) execl(\"/bin/sleep\", \"sleep\", \"$marker\", (char*)nullptr); _exit(0); } return m * g;" \
+  >"$work/orphan/$name"
+grade orphan
+sleep 0.5
+if pgrep -f "sleep $marker" >/dev/null; then
+  problem "orphan: a process the submission started outlived the grader"
+  pkill -f "sleep $marker" || true
+fi
+
+# --- reports only to regular files --------------------------------------------------------------
+echo "an unrelated file" >"$work/victim.txt"
+ln -s "$work/victim.txt" "$work/link.json"
+set +e
+NO_COLOR=1 "$clothlab" grade --impl stubs --exercise ex01.1 --results "$work/link.json" \
+  >"$work/link.out" 2>&1
+code=$?
+set -e
+[[ $code -eq 2 ]] || problem "--results through a symbolic link: exit $code, expected 2"
+[[ $(cat "$work/victim.txt") == "an unrelated file" ]] || problem "--results wrote through a link"
+[[ -L $work/link.json ]] || problem "--results replaced the symbolic link"
+grep -q 'symbolic link' "$work/link.out" || problem "--results through a link: no message"
+mkfifo "$work/fifo.json"
+set +e
+NO_COLOR=1 "$clothlab" grade --impl stubs --exercise ex01.1 --junit "$work/fifo.json" \
+  >"$work/fifo.out" 2>&1
+code=$?
+set -e
+[[ $code -eq 2 && -p $work/fifo.json ]] || problem "--junit onto a fifo: exit $code, or replaced"
+
+# --- two graders at once on one scratch folder --------------------------------------------------
+mkdir -p "$work/slow" "$work/fast"
+patched '' '  for (volatile long spin = 0;; spin = spin + 1) {}' >"$work/slow/$name"
+cp "$solution" "$work/fast/$name"
+NO_COLOR=1 "$clothlab" grade --submission "$work/slow" --scratch "$work/shared" \
+  --results "$work/slow.json" --exercise ex01.1 --timeout 3 >"$work/slow.out" 2>&1 &
+slow=$!
+sleep 1
+NO_COLOR=1 "$clothlab" grade --submission "$work/fast" --scratch "$work/shared" \
+  --results "$work/fast.json" --exercise ex01 >"$work/fast.out" 2>&1 || true
+wait "$slow" || true
+[[ $(score_of "$work/fast.json") == 14 ]] || problem "two graders at once: the honest one scored $(score_of "$work/fast.json")"
+[[ $(score_of "$work/slow.json") == 0 ]] || problem "two graders at once: the looping one scored $(score_of "$work/slow.json")"
+
+[[ $sums_before == "$(tree_sum)" ]] || problem "the project's exercises/, solutions/ or tests/grade/ changed"
+
+if ((${#problems[@]} > 0)); then
+  printf 'check_hostile: %s\n' "${problems[@]}" >&2
+  exit 1
+fi
+echo "every hostile submission scored no more than its code earns"
