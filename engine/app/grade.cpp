@@ -29,6 +29,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <initializer_list>
 #include <iostream>
 #include <memory>
 #include <string>
@@ -42,6 +43,7 @@ namespace clothlab::app {
 namespace {
 
 namespace fs = std::filesystem;
+using namespace std::string_literals;
 using Clock = std::chrono::steady_clock;
 using Fields = std::vector<std::string>;
 
@@ -57,12 +59,13 @@ struct Options {
   std::string binary;      // hidden: grade this doctest binary instead of grade-<impl>
   std::string submission;  // grade the exercise files in this folder
   std::string scratch;     // where a submission is built; default <dir of clothlab>/grade-scratch
-  double build_timeout = 600;  // [s] for configuring, then for compiling, a submission
-  bool autolab = false;        // end with Autolab's one-line JSON score summary
-  std::string classroom;       // write a GitHub Classroom workflow here, and grade nothing
-  bool hidden = false;         // also the hidden cases of tests/grade-hidden/ (instructors)
-  std::string exercises;       // hidden: the student's exercise files; default exercises/
-  int rounds = 0;              // watch: stop after this many gradings (0: never; for tests)
+  double build_timeout = 600;    // [s] for configuring, then for compiling, a submission
+  std::string sandbox = "auto";  // a submission's cases in bubblewrap: auto, on or off
+  bool autolab = false;          // end with Autolab's one-line JSON score summary
+  std::string classroom;         // write a GitHub Classroom workflow here, and grade nothing
+  bool hidden = false;           // also the hidden cases of tests/grade-hidden/ (instructors)
+  std::string exercises;         // hidden: the student's exercise files; default exercises/
+  int rounds = 0;                // watch: stop after this many gradings (0: never; for tests)
 };
 
 // One grading test case: what the listing says, then how its run went.
@@ -442,7 +445,41 @@ std::vector<Case> list_cases(const std::string& binary) {
   return cases;
 }
 
-void run_case(const std::string& binary, Case& c, double timeout) {
+// --- The sandbox --------------------------------------------------------------------------------
+
+// bubblewrap, when it is installed and can make namespaces here (a container may forbid it).
+std::string usable_bwrap() {
+  for (const char* path : {"/usr/bin/bwrap", "/usr/local/bin/bwrap", "/bin/bwrap"}) {
+    if (access(path, X_OK) != 0) continue;
+    const ProcessResult probe = run_process(
+        {path, "--unshare-all", "--die-with-parent", "--ro-bind", "/", "/", "/bin/true"}, 10);
+    if (!probe.timed_out && probe.signal == 0 && probe.exit_code == 0) return path;
+  }
+  return "";
+}
+
+// What runs a grading binary in the sandbox: a new root that holds the system's programs and
+// libraries (read-only), /dev, /proc, an empty /tmp and the binary itself, and nothing of the
+// project, its build, the solutions, the hidden tests, other submissions or home folders; no
+// network, no other process to see or signal, a session of its own (no terminal to type into).
+// Every process in it ends when the case does.
+std::vector<std::string> sandboxed(const std::string& bwrap, const std::string& binary) {
+  std::vector<std::string> args{bwrap, "--unshare-all", "--die-with-parent", "--new-session"};
+  const auto add = [&](std::initializer_list<std::string> more) { args.insert(args.end(), more); };
+  add({"--ro-bind", "/usr", "/usr"});
+  for (const char* dir : {"/lib", "/lib64", "/bin"})
+    add({"--ro-bind-try", dir, dir});  // links into /usr on most systems
+  add({"--ro-bind", "/etc", "/etc"});
+  add({"--dev", "/dev"});
+  add({"--proc", "/proc"});
+  add({"--tmpfs", "/tmp"});
+  add({"--ro-bind", binary, binary});
+  add({"--chdir", "/tmp", "--"});
+  return args;
+}
+
+void run_case(const std::string& binary, Case& c, double timeout,
+              const std::vector<std::string>& sandbox = {}) {
   if (c.name.find(',') != std::string::npos) {
     c.done = true;
     c.status = "failed: the name contains a comma";
@@ -466,9 +503,11 @@ void run_case(const std::string& binary, Case& c, double timeout) {
   limits.cpu_seconds = timeout + 1;
   limits.file_bytes = std::size_t{64} << 20;
   const auto start = Clock::now();
-  const ProcessResult run = run_process({binary, "--reporters=clothlab", "--test-case=" + filter,
-                                         "--case-sensitive=true", "--no-breaks=true"},
-                                        timeout, limits);
+  std::vector<std::string> args = sandbox;
+  for (const std::string& arg : {binary, "--reporters=clothlab"s, "--test-case=" + filter,
+                                 "--case-sensitive=true"s, "--no-breaks=true"s})
+    args.push_back(arg);
+  const ProcessResult run = run_process(args, timeout, limits);
   c.seconds = std::chrono::duration<double>(Clock::now() - start).count();
   judge(c, run, binary, timeout);
 }
@@ -1001,11 +1040,29 @@ void grade(const Options& o) {
     compiled = !binary.empty();
     fmt::print("{}", notes);
   }
+  // A submission's cases run in the sandbox where it works; where it does not, the grader says
+  // loudly what the submission can then do.
+  std::vector<std::string> sandbox;
+  if (submission && compiled && o.sandbox != "off") {
+    const std::string bwrap = usable_bwrap();
+    if (!bwrap.empty()) {
+      sandbox = sandboxed(bwrap, binary);
+    } else if (o.sandbox == "on") {
+      fail(2, "--sandbox on: bubblewrap (bwrap) is not installed or cannot make namespaces here");
+    } else {
+      std::cout << std::flush;
+      std::cerr << "clothlab grade: WARNING: no sandbox (bubblewrap is not installed, or cannot "
+                   "make namespaces here): the submission's code runs as this user and can read "
+                   "and write whatever this user can, the solutions and hidden tests included. "
+                   "Install bubblewrap (Debian: apt-get install bubblewrap), or grade on a machine "
+                   "that holds nothing else.\n";
+    }
+  }
   for (std::size_t i = 0; compiled && i < cases.size() && !g_interrupted; ++i) {
     if (cases[i].done) continue;  // not compiled
     if (colour) fmt::print("\r\033[K[{}/{}] {}", i + 1, cases.size(), cases[i].name.substr(0, 70));
     std::fflush(stdout);
-    run_case(binary, cases[i], o.timeout);
+    run_case(binary, cases[i], o.timeout, sandbox);
     // After every case, so an interrupted run leaves results.
     write_reports(o, cases, elapsed(), notes);
   }
@@ -1152,6 +1209,11 @@ void add_grade_command(CLI::App& app) {
   cmd->add_option("--build-timeout", o->build_timeout,
                   "Seconds configuring, then compiling, a submission may take")
       ->check(CLI::PositiveNumber)
+      ->capture_default_str();
+  cmd->add_option("--sandbox", o->sandbox,
+                  "Run a submission's cases in bubblewrap: auto (where it works, else warn), on "
+                  "(refuse to grade without it) or off")
+      ->check(CLI::IsMember({"auto", "on", "off"}))
       ->capture_default_str();
   cmd->add_flag("--autolab", o->autolab,
                 "End with Autolab's one-line JSON summary of the scores per exercise");

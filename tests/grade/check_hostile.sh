@@ -156,6 +156,29 @@ wait "$slow" || true
 [[ $(score_of "$work/fast.json") == 14 ]] || problem "two graders at once: the honest one scored $(score_of "$work/fast.json")"
 [[ $(score_of "$work/slow.json") == 0 ]] || problem "two graders at once: the looping one scored $(score_of "$work/slow.json")"
 
+# --- the sandbox: nothing of the project to read, nowhere to write -----------------------------
+# Where bubblewrap works (CI installs it and sets CLOTHLAB_REQUIRE_SANDBOX=1), a kernel that reads
+# the solution earns nothing by it, and one that writes into exercises/ leaves nothing there.
+if [[ -x /usr/bin/bwrap ]] && /usr/bin/bwrap --unshare-all --ro-bind / / /bin/true 2>/dev/null; then
+  mkdir -p "$work/reader" "$work/writer"
+  patched '#include <fstream>' "  if (std::ifstream(\"$solution\")) return m * g; return {};" \
+    >"$work/reader/$name"
+  grade reader --sandbox on
+  expect_at_most reader 12
+  planted=$source_dir/exercises/planted-by-a-submission.txt
+  patched '#include <fstream>' "  std::ofstream(\"$planted\") << \"planted\"; return m * g;" \
+    >"$work/writer/$name"
+  grade writer --sandbox on
+  if [[ -e $planted ]]; then
+    problem "writer: a submission wrote into the project's exercises/"
+    rm -f "$planted"
+  fi
+elif [[ ${CLOTHLAB_REQUIRE_SANDBOX:-0} == 1 ]]; then
+  problem "bubblewrap is required here (CLOTHLAB_REQUIRE_SANDBOX=1) but does not work"
+else
+  echo "(bubblewrap is not usable here: the sandbox's own checks are skipped)"
+fi
+
 [[ $sums_before == "$(tree_sum)" ]] || problem "the project's exercises/, solutions/ or tests/grade/ changed"
 
 if ((${#problems[@]} > 0)); then
