@@ -79,35 +79,43 @@ class OutputKeeper {
   explicit OutputKeeper(std::string& output) : output_(output) {}
   void add(const char* data, std::size_t size) {
     std::string_view in(data, size);
-    if (output_.size() < kMaxOutput) {
+    if (!capped_) {
       const std::size_t take = std::min(in.size(), kMaxOutput - output_.size());
       output_.append(in.substr(0, take));
       in.remove_prefix(take);
-      // The line cut at the cap goes on in the lines kept after it.
-      if (in.empty()) return;
+      if (output_.size() < kMaxOutput) return;
+      // At the cap: the line cut there goes on in the lines kept after it.
+      capped_ = true;
       const auto last = output_.rfind('\n');
       line_ = output_.substr(last == std::string::npos ? 0 : last + 1);
       output_.resize(output_.size() - line_.size());
     }
     for (const char c : in) {
       if (c != '\n') {
-        if (line_.size() < kMaxLine) line_ += c;
+        line_ += c;
+        // A line longer than any event keeps only its end, where an event printed after text
+        // without a newline would be.
+        if (line_.size() >= 2 * kMaxLine) line_.erase(0, line_.size() - kMaxLine);
         continue;
       }
-      if (line_.find("@clothlab\t") != std::string::npos && events_ + line_.size() < kMaxEvents) {
-        output_ += line_ + '\n';
-        events_ += line_.size() + 1;
-      }
+      keep_event();
       line_.clear();
     }
   }
-  void finish() {
-    if (!line_.empty() && line_.find("@clothlab\t") != std::string::npos) output_ += line_;
-  }
+  void finish() { keep_event(); }
 
  private:
-  static constexpr std::size_t kMaxLine = 64 << 10;
+  // The current line from its tag on, when it holds one.
+  void keep_event() {
+    const auto at = line_.find("@clothlab\t");
+    if (at == std::string::npos || events_ + line_.size() - at >= kMaxEvents) return;
+    output_.append(line_, at).append("\n");
+    events_ += line_.size() - at + 1;
+  }
+
+  static constexpr std::size_t kMaxLine = 256 << 10;  // longer than any event line
   std::string& output_;
+  bool capped_ = false;  // kMaxOutput reached: only the protocol's lines are kept from here
   std::string line_;
   std::size_t events_ = 0;
 };
