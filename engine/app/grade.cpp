@@ -83,7 +83,7 @@ struct Case {
   bool broken_file = false;   // ...because its own exercise file did not (the student's loop)
   std::string status = "not run";
   std::string message;    // the first failure, with its INFO/CAPTURE hints
-  std::string diagnosis;  // that failure in one line: its first hint, or what went wrong
+  std::string diagnosis;  // that failure in one line: its hint (hint_of), or what went wrong
   std::string output;     // what the case printed itself
   double seconds = 0;
 };
@@ -644,7 +644,6 @@ std::string case_report(const Case& c, bool with_output) {
   return s;
 }
 
-// Written to PATH.tmp then renamed, so a reader never sees half a file.
 // A report goes only to a new file or over a regular one: never through a symbolic link, and
 // never onto a device (as root, `--results /dev/null` would otherwise replace /dev/null).
 void check_report_path(const std::string& option, const std::string& path) {
