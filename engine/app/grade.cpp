@@ -900,6 +900,16 @@ std::string own_scratch() {
   return (fs::path(grade_kit_dir()).parent_path() / "grade-own").string();
 }
 
+// A case that cannot run because what it would grade did not compile: `what` says so ("the
+// submission does not compile"), `error` is the compiler's first error.
+void mark_not_compiled(Case& c, const std::string& what, const std::string& error) {
+  c.done = true;
+  c.not_compiled = true;
+  c.status = "not compiled";
+  c.message = what + ":\n" + error;
+  c.diagnosis = error.substr(0, error.find('\n'));
+}
+
 // "01_particles_and_euler.cpp" holds the exercises of lesson 01: ex01.1, ex01.2, ...
 bool in_file(const Case& c, const std::string& file) {
   const std::string lesson = "ex" + file.substr(0, file.find('_'));
@@ -930,25 +940,16 @@ std::string build_own(const Options& o, std::vector<Case>& cases, std::string& n
     if (g_interrupted) return "";
     build.first_error = printable(build.first_error);
     notes += "Your exercises do not build:\n" + indent(build.first_error, "  ") + "\n\n";
-    for (Case& c : cases) {
-      c.done = true;
-      c.not_compiled = true;
-      c.status = "not compiled";
-      c.message = "the exercises do not build:\n" + build.first_error;
-      c.diagnosis = build.first_error.substr(0, build.first_error.find('\n'));
-    }
+    for (Case& c : cases)
+      mark_not_compiled(c, "the exercises do not build", build.first_error);
     return "";
   }
   for (SubmissionBuild::Broken& broken : build.broken) {
     broken.error = printable(broken.error);
     for (Case& c : cases) {
       if (!in_file(c, broken.name)) continue;
-      c.done = true;
-      c.not_compiled = true;
+      mark_not_compiled(c, "exercises/" + broken.name + " does not compile", broken.error);
       c.broken_file = true;
-      c.status = "not compiled";
-      c.message = "exercises/" + broken.name + " does not compile:\n" + broken.error;
-      c.diagnosis = broken.error.substr(0, broken.error.find('\n'));
     }
   }
   return build.binary;
@@ -1026,12 +1027,8 @@ void grade(const Options& o) {
     if (compiled) {
       binary = build.binary;
     } else if (!g_interrupted) {
-      for (Case& c : cases) {
-        c.done = true;
-        c.not_compiled = true;
-        c.status = "not compiled";
-        c.message = "the submission does not compile:\n" + build.first_error;
-      }
+      for (Case& c : cases)
+        mark_not_compiled(c, "the submission does not compile", build.first_error);
     }
   }
   if (own) {
