@@ -2,8 +2,13 @@
 //
 // doctest runs all cases in one process, so one crash or endless loop would lose every grade
 // after it. The grader therefore lists the cases of a grading binary, then runs each in its own
-// process group with a real timeout, and reads the line protocol printed by the binary's
-// "clothlab" reporter (tests/grade/grade_main.cpp describes it).
+// process group with a real timeout, and reads the line protocol the binary's "clothlab"
+// reporter writes to a pipe of its own (tests/grade/grade_main.cpp describes it).
+//
+// The grading binary (grade-cases) holds the tests but not the exercise kernels: it calls them in
+// a kernels process (grade-kernels-reference, -stubs, or a submission's), which only computes and
+// cannot reach the pipe the verdicts go through (tests/grade/kernel_wire.hpp). A submission's
+// kernels run in a sandbox.
 #include "app/grade.hpp"
 #include "app/process.hpp"
 #include "app/submission.hpp"
@@ -190,23 +195,18 @@ Fields split_event(std::string_view line) {
   return fields;
 }
 
-// Splits a binary's output into reporter events and whatever the test printed itself.
-void parse_output(const std::string& text, std::vector<Fields>& events, std::string& other) {
+// The reporter's events, from the pipe only the grading binary writes (see grade_main.cpp).
+std::vector<Fields> parse_events(const std::string& text) {
+  std::vector<Fields> events;
   std::size_t begin = 0;
   while (begin < text.size()) {
     std::size_t end = text.find('\n', begin);
     if (end == std::string::npos) end = text.size();
     const std::string_view line(text.data() + begin, end - begin);
-    // A case may print without a final newline, so the tag can start mid-line.
-    const std::size_t at = line.find(kTag);
-    if (at == std::string_view::npos) {
-      other.append(line).append("\n");
-    } else {
-      if (at > 0) other.append(line.substr(0, at)).append("\n");
-      events.push_back(split_event(line.substr(at + kTag.size())));
-    }
+    if (line.starts_with(kTag)) events.push_back(split_event(line.substr(kTag.size())));
     begin = end + 1;
   }
+  return events;
 }
 
 // --- Exercises, lessons and messages ---------------------------------------------------------
@@ -302,18 +302,49 @@ std::string hint_of(const Fields& e) {
   return e[4].empty() ? e[5] : fmt::format("{}( {} ) failed", e[3], e[4]);
 }
 
+// The signal in the text of KernelsEnded (kernel_client.cpp) when the kernels' process died of
+// one: "crashed: signal 11 (...)"; 0 otherwise.
+int kernels_signal(const std::string& text) {
+  constexpr std::string_view kCrashed = "crashed: signal ";
+  if (!text.starts_with(kCrashed)) return 0;
+  return std::atoi(text.c_str() + kCrashed.size());
+}
+
+// What grades: a grading binary, and the kernels program it calls (empty for a binary that has
+// its own code, like the grader's self-test), in the sandbox when there is one.
+struct Grader {
+  std::string binary;
+  std::string kernels;
+  std::vector<std::string> sandbox;  // the command the kernels run in, or empty
+
+  // The environment that tells the binary how to start the kernels (kernel_client.cpp).
+  std::vector<std::string> environment() const {
+    if (kernels.empty()) return {};
+    std::string command;
+    for (const std::string& arg : sandbox)
+      command += arg + '\x1f';
+    return {"CLOTHLAB_KERNELS=" + command + kernels};
+  }
+  // How to run a case by hand (without the sandbox).
+  std::string command() const {
+    return (kernels.empty() ? "" : "CLOTHLAB_KERNELS=" + kernels + " ") + binary;
+  }
+};
+
 // Decides a case's status from how its process ended and what its reporter said.
-void judge(Case& c, const ProcessResult& run, const std::string& binary, double timeout) {
-  std::vector<Fields> events;
-  parse_output(run.output, events, c.output);
+void judge(Case& c, const ProcessResult& run, const Grader& grader, double timeout) {
+  std::vector<Fields> events = parse_events(run.events);
+  c.output = run.output;
 
   int starts = 0;
   bool ended = false;
   bool reported_pass = false;
   std::string first_failure;
-  std::string first_hint;  // the first failure in one line (hint_of), or the exception's text
-  std::string missing;     // the exercise a NotImplemented named
-  std::string crash;       // what doctest said when it caught a crash signal
+  std::string first_hint;     // the first failure in one line (hint_of), or the exception's text
+  std::string missing;        // the exercise a NotImplemented named
+  std::string crash;          // what doctest said when it caught a crash signal
+  int kernels_sig = 0;        // the signal the kernels' process died of, when it did
+  std::string kernels_crash;  // and what the grading binary said of it
   for (Fields& e : events) {
     // The fewest fields each event has, so that a line cut short cannot crash the grader.
     const std::size_t fields = e[0] == "fail" ? 6 : e[0] == "note" ? 4 : 3;
@@ -328,6 +359,8 @@ void judge(Case& c, const ProcessResult& run, const std::string& binary, double 
       }
       if (missing.empty()) missing = not_implemented_in(is_fail ? e[5] : e[2]);
       if (!is_fail && e[1] == "crash") crash = e[2];
+      if (!is_fail && kernels_sig == 0 && (kernels_sig = kernels_signal(e[2])) != 0)
+        kernels_crash = e[2];
     } else if (e[0] == "note") {
       c.output += fmt::format("note: {}\n", e[3]);
     } else if (e[0] == "end") {
@@ -345,9 +378,13 @@ void judge(Case& c, const ProcessResult& run, const std::string& binary, double 
     c.status = fmt::format("timed out after {:g} s", timeout);
     c.message = fmt::format("the case did not finish within {:g} s: an endless loop?", timeout) +
                 (first_failure.empty() ? "" : "\nbefore that, " + first_failure);
-  } else if (run.signal != 0 || !crash.empty()) {
-    const SignalInfo sig = crash_signal(run.signal, crash);
+  } else if (run.signal != 0 || !crash.empty() || kernels_sig != 0) {
+    const SignalInfo sig = kernels_sig != 0 && run.signal == 0 ? signal_info(kernels_sig)
+                                                               : crash_signal(run.signal, crash);
     c.status = fmt::format("crashed: {}", sig.name);
+    if (kernels_sig != 0 && run.signal == 0 && crash.empty())
+      c.message = fmt::format("the exercise's code was killed by signal {} ({}){}", kernels_sig,
+                              sig.name, kernels_crash.substr(kernels_crash.find(' ', 16)));
     if (c.message.empty())
       c.message = fmt::format("the process was killed by signal {}", run.signal);
     if (*sig.hint != '\0') c.message += fmt::format("\n{}", sig.hint);
@@ -374,9 +411,9 @@ void judge(Case& c, const ProcessResult& run, const std::string& binary, double 
     if (c.message.empty())
       c.message = fmt::format("the test program exited with code {}", run.exit_code);
   }
-  if (run.timed_out || run.signal != 0 || !crash.empty()) {
-    c.message += fmt::format("\nto run this case alone (in a debugger, say): {} --test-case=\"{}\"",
-                             binary, c.name);
+  if (run.timed_out || run.signal != 0 || !crash.empty() || kernels_sig != 0) {
+    c.message +=
+        fmt::format("\nto run this case alone: {} --test-case=\"{}\"", grader.command(), c.name);
   }
   // One line: the first hint when the status alone does not say what went wrong.
   const std::string line = (c.passed || c.not_started) ? ""
@@ -393,10 +430,9 @@ void judge(Case& c, const ProcessResult& run, const std::string& binary, double 
 // --- Listing and running cases ----------------------------------------------------------------
 
 std::vector<Case> list_cases(const std::string& binary) {
-  const ProcessResult run = run_process({binary, "--list-test-cases", "--reporters=clothlab"}, 60);
-  std::vector<Fields> events;
-  std::string other;
-  parse_output(run.output, events, other);
+  const ProcessResult run =
+      run_process({binary, "--list-test-cases", "--reporters=clothlab"}, 60, {}, {}, true);
+  std::vector<Fields> events = parse_events(run.events);
   if (run.timed_out || run.signal != 0 || run.exit_code != 0) {
     fail(2, fmt::format("listing the cases of {} failed:\n{}", binary, run.output));
   }
@@ -458,11 +494,12 @@ std::string usable_bwrap() {
   return "";
 }
 
-// What runs a grading binary in the sandbox: a new root that holds the system's programs and
-// libraries (read-only), /dev, /proc, an empty /tmp and the binary itself, and nothing of the
-// project, its build, the solutions, the hidden tests, other submissions or home folders; no
-// network, no other process to see or signal, a session of its own (no terminal to type into).
-// Every process in it ends when the case does.
+// What runs a submission's kernels program in the sandbox: a new root that holds the system's
+// programs and libraries (read-only), /dev, /proc, an empty /tmp and the program itself, and
+// nothing of the project, its build, the grading binary, the solutions, the hidden tests, other
+// submissions or home folders; no network, no other process to see or signal (the grading binary
+// included), a session of its own (no terminal to type into). Every process in it ends when the
+// case does.
 std::vector<std::string> sandboxed(const std::string& bwrap, const std::string& binary) {
   std::vector<std::string> args{bwrap, "--unshare-all", "--die-with-parent", "--new-session"};
   const auto add = [&](std::initializer_list<std::string> more) { args.insert(args.end(), more); };
@@ -478,8 +515,7 @@ std::vector<std::string> sandboxed(const std::string& bwrap, const std::string& 
   return args;
 }
 
-void run_case(const std::string& binary, Case& c, double timeout,
-              const std::vector<std::string>& sandbox = {}) {
+void run_case(const Grader& grader, Case& c, double timeout) {
   if (c.name.find(',') != std::string::npos) {
     c.done = true;
     c.status = "failed: the name contains a comma";
@@ -503,13 +539,12 @@ void run_case(const std::string& binary, Case& c, double timeout,
   limits.cpu_seconds = timeout + 1;
   limits.file_bytes = std::size_t{64} << 20;
   const auto start = Clock::now();
-  std::vector<std::string> args = sandbox;
-  for (const std::string& arg : {binary, "--reporters=clothlab"s, "--test-case=" + filter,
-                                 "--case-sensitive=true"s, "--no-breaks=true"s})
-    args.push_back(arg);
-  const ProcessResult run = run_process(args, timeout, limits);
+  const ProcessResult run =
+      run_process({grader.binary, "--reporters=clothlab", "--test-case=" + filter,
+                   "--case-sensitive=true", "--no-breaks=true"},
+                  timeout, limits, grader.environment(), true);
   c.seconds = std::chrono::duration<double>(Clock::now() - start).count();
-  judge(c, run, binary, timeout);
+  judge(c, run, grader, timeout);
 }
 
 // --- Reports ------------------------------------------------------------------------------------
@@ -836,16 +871,13 @@ std::string classroom_workflow(const std::vector<Case>& cases) {
 
 // --- The command --------------------------------------------------------------------------------
 
-std::string binary_for(const std::string& impl) {
-  if (impl == "reference" && !CLOTHLAB_HAVE_SOLUTIONS) {
-    fail(2, "this is a student release: it has no reference solutions to grade");
-  }
-  // The grading binaries are built next to clothlab.
-  const fs::path path = fs::path(build_dir()) / ("grade-" + impl);
+// A program of the build folder: the grading binary and the kernels programs are built next to
+// clothlab.
+std::string built_program(const std::string& name) {
+  const fs::path path = fs::path(build_dir()) / name;
   if (!fs::exists(path)) {
-    fail(2, fmt::format(
-                "{} does not exist: build it first with\n  cmake --build build --target grade-{}",
-                path.string(), impl));
+    fail(2, fmt::format("{} does not exist: build it first with\n  cmake --build build --target {}",
+                        path.string(), name));
   }
   return path.string();
 }
@@ -966,18 +998,20 @@ void grade(const Options& o) {
   check_report_path("--classroom", o.classroom);
   adopt_orphans();  // a process a case leaves behind is handed to the grader, which ends it
   if ((submission || own) &&
-      (grading || !fs::exists(fs::path(grade_kit_dir()).parent_path() / "grade-stubs"))) {
+      (grading || !fs::exists(fs::path(grade_kit_dir()).parent_path() / "grade-cases"))) {
     const std::string why = update_grade_kit(o.build_timeout);
     if (!why.empty()) fail(2, why);
   }
-  std::string binary = submission || own  ? binary_for("stubs")
-                       : o.binary.empty() ? binary_for(o.impl)
-                                          : o.binary;
-  if (!fs::exists(binary)) fail(2, binary + " does not exist");
-  // The cases of a submission, or of the student's exercises, are listed by the shipped stubs'
-  // binary, built from the same grading tests: nothing of the submission runs outside the
-  // process of one case.
-  std::vector<Case> cases = list_cases(binary);
+  if (o.impl == "reference" && !CLOTHLAB_HAVE_SOLUTIONS && !submission && o.binary.empty())
+    fail(2, "this is a student release: it has no reference solutions to grade");
+  // The grading binary, and the kernels it calls: those of --impl, or those the kit builds below
+  // from a submission or the student's exercises. (--binary: a binary with code of its own.)
+  Grader grader;
+  grader.binary = o.binary.empty() ? built_program("grade-cases") : o.binary;
+  if (!fs::exists(grader.binary)) fail(2, grader.binary + " does not exist");
+  if (!submission && !own && o.binary.empty())
+    grader.kernels = built_program("grade-kernels-" + o.impl);
+  std::vector<Case> cases = list_cases(grader.binary);
   // The hidden cases count only when an instructor asks for them: a student's grade has the
   // cases and points the lessons quote.
   if (!o.hidden) std::erase_if(cases, [](const Case& c) { return c.hidden_test; });
@@ -1025,24 +1059,23 @@ void grade(const Options& o) {
     fmt::print("{}", notes);
     compiled = build.built;
     if (compiled) {
-      binary = build.binary;
+      grader.kernels = build.binary;
     } else if (!g_interrupted) {
       for (Case& c : cases)
         mark_not_compiled(c, "the submission does not compile", build.first_error);
     }
   }
   if (own) {
-    binary = build_own(o, cases, notes, colour, hold);
-    compiled = !binary.empty();
+    grader.kernels = build_own(o, cases, notes, colour, hold);
+    compiled = !grader.kernels.empty();
     fmt::print("{}", notes);
   }
   // A submission's cases run in the sandbox where it works; where it does not, the grader says
   // loudly what the submission can then do.
-  std::vector<std::string> sandbox;
   if (submission && compiled && o.sandbox != "off") {
     const std::string bwrap = usable_bwrap();
     if (!bwrap.empty()) {
-      sandbox = sandboxed(bwrap, binary);
+      grader.sandbox = sandboxed(bwrap, grader.kernels);
     } else if (o.sandbox == "on") {
       fail(2, "--sandbox on: bubblewrap (bwrap) is not installed or cannot make namespaces here");
     } else {
@@ -1058,7 +1091,7 @@ void grade(const Options& o) {
     if (cases[i].done) continue;  // not compiled
     if (colour) fmt::print("\r\033[K[{}/{}] {}", i + 1, cases.size(), cases[i].name.substr(0, 70));
     std::fflush(stdout);
-    run_case(binary, cases[i], o.timeout, sandbox);
+    run_case(grader, cases[i], o.timeout);
     // After every case, so an interrupted run leaves results.
     write_reports(o, cases, elapsed(), notes);
   }

@@ -1,9 +1,10 @@
 // grade.hpp: the `clothlab grade` subcommand.
 //
-// The grader runs the grading tests (tests/grade/NN_*.cpp, built into grade-student,
-// grade-reference and grade-stubs next to this program) one case per process, so that a crash or
-// an endless loop costs that case only, and reports points per exercise with hints that point to
-// the lesson. It also writes Gradescope results.json and JUnit XML.
+// The grader runs the grading tests (tests/grade/NN_*.cpp, built into grade-cases next to this
+// program) one case per process, so that a crash or an endless loop costs that case only, with
+// the exercise kernels under test in a process of their own (grade-kernels-reference, -stubs, or
+// those it builds from the student's exercises or a submission), and reports points per exercise
+// with hints that point to the lesson. It also writes Gradescope results.json and JUnit XML.
 #pragma once
 
 namespace CLI {

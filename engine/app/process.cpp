@@ -72,53 +72,39 @@ void end_orphans() {
   }
 }
 
-// Keeps what the child prints: the first kMaxOutput bytes as they come, then only the protocol's
-// lines (see kMaxOutput).
-class OutputKeeper {
+// Keeps at most `cap` bytes of what comes through a pipe, and counts what it leaves out.
+class Capped {
  public:
-  explicit OutputKeeper(std::string& output) : output_(output) {}
+  Capped(std::string& text, std::size_t cap) : text_(text), cap_(cap) {}
   void add(const char* data, std::size_t size) {
-    std::string_view in(data, size);
-    if (!capped_) {
-      const std::size_t take = std::min(in.size(), kMaxOutput - output_.size());
-      output_.append(in.substr(0, take));
-      in.remove_prefix(take);
-      if (output_.size() < kMaxOutput) return;
-      // At the cap: the line cut there goes on in the lines kept after it.
-      capped_ = true;
-      const auto last = output_.rfind('\n');
-      line_ = output_.substr(last == std::string::npos ? 0 : last + 1);
-      output_.resize(output_.size() - line_.size());
-    }
-    for (const char c : in) {
-      if (c != '\n') {
-        line_ += c;
-        // A line longer than any event keeps only its end, where an event printed after text
-        // without a newline would be.
-        if (line_.size() >= 2 * kMaxLine) line_.erase(0, line_.size() - kMaxLine);
-        continue;
-      }
-      keep_event();
-      line_.clear();
-    }
+    const std::size_t take = std::min(size, cap_ - text_.size());
+    text_.append(data, take);
+    dropped_ += size - take;
   }
-  void finish() { keep_event(); }
+  std::size_t dropped() const { return dropped_; }
 
  private:
-  // The current line from its tag on, when it holds one.
-  void keep_event() {
-    const auto at = line_.find("@clothlab\t");
-    if (at == std::string::npos || events_ + line_.size() - at >= kMaxEvents) return;
-    output_.append(line_, at).append("\n");
-    events_ += line_.size() - at + 1;
-  }
-
-  static constexpr std::size_t kMaxLine = 256 << 10;  // longer than any event line
-  std::string& output_;
-  bool capped_ = false;  // kMaxOutput reached: only the protocol's lines are kept from here
-  std::string line_;
-  std::size_t events_ = 0;
+  std::string& text_;
+  std::size_t cap_;
+  std::size_t dropped_ = 0;
 };
+
+// The environment of the child: this one's, with `set` ("NAME=value") in place of the same
+// names, and no CLOTHLAB_EVENTS_FD unless `set` gives it.
+std::vector<std::string> environment(const std::vector<std::string>& set) {
+  std::vector<std::string> env = set;
+  auto name_of = [](std::string_view entry) { return entry.substr(0, entry.find('=')); };
+  for (char** e = environ; *e != nullptr; ++e) {
+    const std::string_view entry(*e);
+    const std::string_view name = name_of(entry);
+    if (name == "CLOTHLAB_EVENTS_FD") continue;
+    if (std::any_of(set.begin(), set.end(),
+                    [&](const std::string& s) { return name_of(s) == name; }))
+      continue;
+    env.emplace_back(entry);
+  }
+  return env;
+}
 
 }  // namespace
 
@@ -141,15 +127,25 @@ InterruptGuard::~InterruptGuard() {
 }
 
 ProcessResult run_process(const std::vector<std::string>& args, double timeout,
-                          const ProcessLimits& limits) {
+                          const ProcessLimits& limits, const std::vector<std::string>& env,
+                          bool events) {
   // Built before fork(): the child may only make async-signal-safe calls.
   std::vector<char*> argv;
   for (const auto& a : args)
     argv.push_back(const_cast<char*>(a.c_str()));
   argv.push_back(nullptr);
+  std::vector<std::string> env_entries = env;
+  if (events) env_entries.push_back("CLOTHLAB_EVENTS_FD=" + std::to_string(kEventsFd));
+  env_entries = environment(env_entries);
+  std::vector<char*> envp;
+  for (auto& e : env_entries)
+    envp.push_back(e.data());
+  envp.push_back(nullptr);
 
   int fds[2];
-  if (pipe2(fds, O_CLOEXEC) != 0) throw std::system_error(errno, std::generic_category(), "pipe");
+  int event_fds[2] = {-1, -1};
+  if (pipe2(fds, O_CLOEXEC) != 0 || (events && pipe2(event_fds, O_CLOEXEC) != 0))
+    throw std::system_error(errno, std::generic_category(), "pipe");
   const pid_t pid = fork();
   if (pid < 0) throw std::system_error(errno, std::generic_category(), "fork");
   if (pid == 0) {
@@ -169,13 +165,21 @@ ProcessResult run_process(const std::vector<std::string>& args, double timeout,
     if (null_fd >= 0) dup2(null_fd, STDIN_FILENO);
     dup2(fds[1], STDOUT_FILENO);
     dup2(fds[1], STDERR_FILENO);
-    execv(argv[0], argv.data());
+    if (events) {
+      // dup2 onto itself would leave it close-on-exec.
+      if (event_fds[1] == kEventsFd)
+        fcntl(kEventsFd, F_SETFD, 0);
+      else
+        dup2(event_fds[1], kEventsFd);
+    }
+    execve(argv[0], argv.data(), envp.data());
     const char message[] = "clothlab grade: cannot execute the program\n";
     [[maybe_unused]] auto ignored = write(STDERR_FILENO, message, sizeof message - 1);
     _exit(127);
   }
   setpgid(pid, pid);  // also here, so the kill below cannot race the child's own call
   close(fds[1]);
+  if (events) close(event_fds[1]);
 
   ProcessResult result;
   const auto deadline = Clock::now() + std::chrono::duration<double>(timeout);
@@ -188,10 +192,13 @@ ProcessResult run_process(const std::vector<std::string>& args, double timeout,
     reason = true;
   };
 
-  // Read until end of file (the case and anything it started closed the pipe) or the deadline.
+  // Read until end of file on both pipes (the case and anything it started closed them) or the
+  // deadline.
   char buffer[4096];
-  OutputKeeper keeper(result.output);
-  for (;;) {
+  Capped output(result.output, kMaxOutput);
+  Capped event_lines(result.events, kMaxEvents);
+  pollfd p[2] = {{fds[0], POLLIN, 0}, {event_fds[0], POLLIN, 0}};  // fd -1: ignored by poll
+  while (p[0].fd >= 0 || p[1].fd >= 0) {
     if (g_interrupted) {
       stop(result.interrupted);
       break;
@@ -201,16 +208,23 @@ ProcessResult run_process(const std::vector<std::string>& args, double timeout,
       stop(result.timed_out);
       break;
     }
-    pollfd p{fds[0], POLLIN, 0};
-    const int ready = poll(&p, 1, static_cast<int>(std::min<long>(left, 1000)));
+    const int ready = poll(p, 2, static_cast<int>(std::min<long>(left, 1000)));
     if (ready <= 0) continue;  // timeout slice or EINTR: check the deadline and the flag again
-    const ssize_t got = read(fds[0], buffer, sizeof buffer);
-    if (got < 0 && errno == EINTR) continue;
-    if (got <= 0) break;
-    keeper.add(buffer, static_cast<std::size_t>(got));
+    for (int k = 0; k < 2; ++k) {
+      if (p[k].fd < 0 || p[k].revents == 0) continue;
+      const ssize_t got = read(p[k].fd, buffer, sizeof buffer);
+      if (got < 0 && errno == EINTR) continue;
+      if (got <= 0) {
+        p[k].fd = -1;
+        continue;
+      }
+      (k == 0 ? output : event_lines).add(buffer, static_cast<std::size_t>(got));
+    }
   }
-  keeper.finish();
+  if (output.dropped() > 0)
+    result.output += "\n[... " + std::to_string(output.dropped()) + " more bytes not kept]\n";
   close(fds[0]);
+  if (events) close(event_fds[0]);
 
   // The pipe can close before the process ends: wait for it, still under the deadline.
   int status = 0;

@@ -32,17 +32,19 @@ class InterruptGuard {
 
 struct ProcessResult {
   std::string output;  // stdout and stderr, interleaved as written
+  std::string events;  // what it wrote to kEventsFd, when asked for
   int exit_code = 0;   // meaningful when signal == 0 and the run was not cut off
   int signal = 0;
   bool timed_out = false;
   bool interrupted = false;
 };
 
-// At most 1 MiB of a chatty child's own output is kept. Past that, only the lines of the grading
-// binaries' protocol (tagged "@clothlab\t", up to kMaxEvents bytes) are kept, so that an honest
-// case that prints a lot is still judged on what its reporter said.
+// At most 1 MiB of a chatty child's output is kept, and 4 MiB of its events: an honest case that
+// prints a lot is still judged on what its reporter said, which comes through a pipe of its own.
 constexpr std::size_t kMaxOutput = 1 << 20;
 constexpr std::size_t kMaxEvents = 4 << 20;
+// The descriptor a grading binary writes its events to (it is told so by CLOTHLAB_EVENTS_FD).
+constexpr int kEventsFd = 3;
 
 // Limits set on the child (setrlimit) before it runs, inherited by whatever it starts; 0 leaves
 // a limit as it is. A child that passes one is stopped by the kernel: out of memory (an
@@ -53,11 +55,15 @@ struct ProcessLimits {
   std::size_t file_bytes = 0;    // size of any file it writes (RLIMIT_FSIZE)
 };
 
-// Runs args[0] (an absolute path) with args, stdin from /dev/null, for at most timeout [s].
+// Runs args[0] (an absolute path) with args, stdin from /dev/null, for at most timeout [s], with
+// this process's environment and `env` ("NAME=value", in place of the same names). With
+// `events`, the child also gets a pipe of its own as descriptor kEventsFd (and
+// CLOTHLAB_EVENTS_FD=3 in its environment), read into ProcessResult::events.
 // Whatever the child started ends with it: its process group is killed when it ends, and so is
 // any process that left the group (setsid) and was handed to this one when its parent died.
 ProcessResult run_process(const std::vector<std::string>& args, double timeout,
-                          const ProcessLimits& limits = {});
+                          const ProcessLimits& limits = {},
+                          const std::vector<std::string>& env = {}, bool events = false);
 
 // Makes this process the one that orphans of its children are handed to (a "subreaper"), so that
 // run_process can end them. Called once by the grader before it runs anything.

@@ -394,7 +394,7 @@ SubmissionBuild build_submission(const std::string& submission_dir, const std::s
   }
 
   // A binary left from the submission graded before must never be graded for this one.
-  const fs::path binary = build / "grade-submission";
+  const fs::path binary = build / "grade-kernels";
   fs::remove(binary, ec);
 
   const auto shown = [&](const std::string& text) {

@@ -4,8 +4,9 @@
 // The submission's exercise files are copied into a scratch folder (never into the user's
 // exercises/), a shipped stub stands in for each file the submission lacks, and a small CMake
 // project that the build generated next to clothlab (grade-kit/) compiles those files alone and
-// links them with the engine and grading-test objects the project's build already made. Nothing
-// of the submission runs here: it is only compiled.
+// links them with the engine's objects the project's build already made, into the kernels
+// program the grading binary calls (grade-kernels, see tests/grade/kernel_wire.hpp). Nothing of
+// the submission runs here: it is only compiled, and no test is linked with it.
 #pragma once
 
 #include <memory>
@@ -16,7 +17,7 @@ namespace clothlab::app {
 
 struct SubmissionBuild {
   bool built = false;
-  std::string binary;       // the grading binary on the submission's kernels, when built
+  std::string binary;       // the kernels program of the submission, when built
   std::string first_error;  // why it was not built: the compiler's first error, or what failed
   std::string log;          // the build's output, with scratch paths shown as exercises/...
   std::vector<std::string> taken;    // exercise files taken from the submission
@@ -47,9 +48,9 @@ struct SubmissionBuild {
 SubmissionBuild build_submission(const std::string& submission_dir, const std::string& scratch_dir,
                                  double timeout, bool stub_broken_files = false);
 
-// Brings what the kit links (the engine, the grading tests' objects, the shipped stubs' grader)
-// up to date, by building the target grade-kit of the project's build folder (the folder this
-// program is in) when it is one. Returns "" or why it failed.
+// Brings what the kit links (the engine, the kernels' main, the shipped stubs) and the grading
+// binary up to date, by building the target grade-kit of the project's build folder (the folder
+// this program is in) when it is one. Returns "" or why it failed.
 std::string update_grade_kit(double timeout);
 
 // The build folder the running program belongs to: the folder of clothlab (and of the grading

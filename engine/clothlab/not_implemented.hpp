@@ -14,11 +14,14 @@ class NotImplemented : public std::logic_error {
   NotImplemented(const std::string& exercise, const std::string& lesson)
       : std::logic_error("exercise " + exercise + " is not implemented yet: see " + lesson +
                          " and fill in the marked region in exercises/"),
-        exercise_(exercise) {}
+        exercise_(exercise),
+        lesson_(lesson) {}
   const std::string& exercise() const { return exercise_; }
+  const std::string& lesson() const { return lesson_; }
 
  private:
   std::string exercise_;
+  std::string lesson_;
 };
 
 }  // namespace clothlab

@@ -112,7 +112,7 @@ if [[ $gradescope -eq 1 ]]; then
   else
     echo "(not root: building the autograder without its apt-get step)"
     (cd "$root/source/clothlab" && cmake -S . -B build >/dev/null &&
-      cmake --build build --parallel "$jobs" --target clothlab grade-stubs >/dev/null)
+      cmake --build build --parallel "$jobs" --target clothlab grade-kit >/dev/null)
   fi
   cp "$source_dir"/solutions/01_*.cpp "$source_dir"/solutions/02_*.cpp "$root/submission/"
   AUTOGRADER_ROOT=$root bash "$root/source/run_autograder"

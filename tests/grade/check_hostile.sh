@@ -122,6 +122,60 @@ if pgrep -f "sleep $marker" >/dev/null; then
   pkill -f "sleep $marker" || true
 fi
 
+# --- verdicts the submission's process would write -------------------------------------------
+# The kernels run in a process of their own, which holds no test and cannot reach the pipe the
+# verdicts go through: what it prints, exits with or links in earns nothing.
+stub=$source_dir/exercises/$name
+fake_events='"@clothlab\tstart\tx\n@clothlab\tend\tpassed\t0\n"'
+mkdir -p "$work/exit-handler" "$work/end-then-exit" "$work/fd-thief" "$work/defaults" \
+  "$work/check-override"
+# The stubs, and a handler at exit that prints what a passing case prints and exits 0.
+{
+  cat "$stub"
+  printf '%s\n' '#include <cstdio>' '#include <cstdlib>' '#include <unistd.h>' \
+    'namespace { void fake() { for (int fd : {1, 2, 3, 4, 5, 6}) dprintf(fd, '"$fake_events"'); _exit(0); }' \
+    'const int registered = std::atexit(fake); }'
+} >"$work/exit-handler/$name"
+grade exit-handler
+expect_at_most exit-handler 0
+compiled() { grep -q "not compiled" "$work/$1.out" && problem "$1: does not compile, so it proves nothing"; true; }
+compiled exit-handler
+# One kernel prints the end of a passing case, then leaves at once.
+fake_decl="static const char* const kFake = $fake_events;"
+patched "#include <cstdio>
+#include <unistd.h>
+$fake_decl" '  std::fputs(kFake, stdout); std::fflush(stdout); _exit(0);' >"$work/end-then-exit/$name"
+grade end-then-exit
+expect_at_most end-then-exit 12
+compiled end-then-exit
+# One kernel writes passing events to every descriptor it can, and to its parent's.
+patched "#include <cstdio>
+#include <fcntl.h>
+#include <string>
+#include <unistd.h>
+$fake_decl" '  for (int fd = 0; fd < 64; ++fd) dprintf(fd, "%s", kFake); for (int fd = 0; fd < 64; ++fd) { const int f = open(("/proc/" + std::to_string(getppid()) + "/fd/" + std::to_string(fd)).c_str(), O_WRONLY); if (f >= 0) dprintf(f, "%s", kFake); } return {};' \
+  >"$work/fd-thief/$name"
+grade fd-thief
+compiled fd-thief
+if [[ -x /usr/bin/bwrap ]] && /usr/bin/bwrap --unshare-all --ro-bind / / /bin/true 2>/dev/null; then
+  expect_at_most fd-thief 12
+fi
+# Kernels that return defaults, then the same with the test framework's checks overridden at link
+# time. The kernels program holds no test framework (it does not even link: the file's
+# registration needs doctest's code), and were it to, it runs no check: nothing more is earned.
+defaults=$(sed 's|  CLOTHLAB_TODO(.*|  return {};|' "$stub")
+printf '%s\n' "$defaults" >"$work/defaults/$name"
+grade defaults
+compiled defaults
+defaults_score=$score
+{
+  printf '%s\n' '#include <doctest/doctest.h>' "$defaults"
+  printf '%s\n' 'bool doctest::detail::ResultBuilder::log() { return false; }' \
+    'void doctest::detail::ResultBuilder::react() const {}'
+} >"$work/check-override/$name"
+grade check-override
+expect_at_most check-override "$defaults_score"
+
 # --- reports only to regular files --------------------------------------------------------------
 echo "an unrelated file" >"$work/victim.txt"
 ln -s "$work/victim.txt" "$work/link.json"
@@ -173,6 +227,17 @@ if [[ -x /usr/bin/bwrap ]] && /usr/bin/bwrap --unshare-all --ro-bind / / /bin/tr
     problem "writer: a submission wrote into the project's exercises/"
     rm -f "$planted"
   fi
+  # Before main, the kernels' pipes are still its standard input and output: a submission that
+  # hands them to the reference kernels would score what the reference does, were the build
+  # folder visible.
+  mkdir -p "$work/exec-reference"
+  reference=$(dirname "$clothlab")/grade-kernels-reference
+  { cat "$stub"; printf '%s\n' '#include <unistd.h>' \
+      "namespace { const int taken = execl(\"$reference\", \"k\", (char*)nullptr); }"; } \
+    >"$work/exec-reference/$name"
+  grade exec-reference --sandbox on
+  compiled exec-reference
+  expect_at_most exec-reference 0
 elif [[ ${CLOTHLAB_REQUIRE_SANDBOX:-0} == 1 ]]; then
   problem "bubblewrap is required here (CLOTHLAB_REQUIRE_SANDBOX=1) but does not work"
 else
