@@ -483,23 +483,64 @@ std::vector<Case> list_cases(const std::string& binary) {
 
 // --- The sandbox --------------------------------------------------------------------------------
 
-// bubblewrap, when it is installed and can make namespaces here (a container may forbid it).
-std::string usable_bwrap() {
+// True when args runs and exits 0 within 10 s.
+bool runs(const std::vector<std::string>& args) {
+  const ProcessResult probe = run_process(args, 10);
+  return !probe.timed_out && probe.signal == 0 && probe.exit_code == 0;
+}
+
+template <class... More>
+std::vector<std::string> joined(std::vector<std::string> a, const More&... more) {
+  (a.insert(a.end(), more.begin(), more.end()), ...);
+  return a;
+}
+
+// bubblewrap, when it is installed and can make namespaces here (a container may forbid it), for
+// a process started with `prefix` (as another user, say).
+std::string usable_bwrap(const std::vector<std::string>& prefix) {
   for (const char* path : {"/usr/bin/bwrap", "/usr/local/bin/bwrap", "/bin/bwrap"}) {
     if (access(path, X_OK) != 0) continue;
-    const ProcessResult probe = run_process(
-        {path, "--unshare-all", "--die-with-parent", "--ro-bind", "/", "/", "/bin/true"}, 10);
-    if (!probe.timed_out && probe.signal == 0 && probe.exit_code == 0) return path;
+    if (runs(joined(prefix, std::vector<std::string>{path, "--unshare-all", "--die-with-parent",
+                                                     "--ro-bind", "/", "/", "/bin/true"})))
+      return path;
   }
   return "";
+}
+
+// When the grader runs as root, a submission's kernels run as the user nobody (util-linux's
+// setpriv switches to it): they cannot write the grader's files, signal or read its processes,
+// and the limit on processes holds for them (the kernel exempts root from it). Empty when the
+// grader is not root, or when nobody cannot run the kernels program (a build folder under a
+// folder only root may enter).
+std::vector<std::string> as_nobody(const std::string& kernels) {
+  const std::vector<std::string> setpriv{"/usr/bin/setpriv", "--reuid=65534", "--regid=65534",
+                                         "--clear-groups"};
+  if (geteuid() != 0 || access(setpriv[0].c_str(), X_OK) != 0) return {};
+  if (!runs(joined(setpriv, std::vector<std::string>{"/usr/bin/test", "-x", kernels}))) {
+    std::cout << std::flush;
+    std::cerr << "clothlab grade: warning: the user nobody cannot run " << kernels
+              << " (a folder above it is closed to other users): the submission's kernels run as "
+                 "root.\n";
+    return {};
+  }
+  return setpriv;
+}
+
+// At most kMaxProcesses processes for the kernels program, through util-linux's prlimit. The
+// kernel counts them per user (in a sandbox's user namespace, the sandbox's own), and does not
+// hold root to the limit: see as_nobody.
+constexpr int kMaxProcesses = 64;
+std::vector<std::string> process_limit() {
+  if (access("/usr/bin/prlimit", X_OK) != 0) return {};
+  return {"/usr/bin/prlimit", fmt::format("--nproc={}", kMaxProcesses)};
 }
 
 // What runs a submission's kernels program in the sandbox: a new root that holds the system's
 // programs and libraries (read-only), /dev, /proc, an empty /tmp and the program itself, and
 // nothing of the project, its build, the grading binary, the solutions, the hidden tests, other
 // submissions or home folders; no network, no other process to see or signal (the grading binary
-// included), a session of its own (no terminal to type into). Every process in it ends when the
-// case does.
+// included), a session of its own (no terminal to type into), and at most kMaxProcesses processes
+// (see process_limit). Every process in it ends when the case does.
 std::vector<std::string> sandboxed(const std::string& bwrap, const std::string& binary) {
   std::vector<std::string> args{bwrap, "--unshare-all", "--die-with-parent", "--new-session"};
   const auto add = [&](std::initializer_list<std::string> more) { args.insert(args.end(), more); };
@@ -512,6 +553,8 @@ std::vector<std::string> sandboxed(const std::string& bwrap, const std::string& 
   add({"--tmpfs", "/tmp"});
   add({"--ro-bind", binary, binary});
   add({"--chdir", "/tmp", "--"});
+  for (const std::string& arg : process_limit())
+    args.push_back(arg);
   return args;
 }
 
@@ -1070,21 +1113,24 @@ void grade(const Options& o) {
     compiled = !grader.kernels.empty();
     fmt::print("{}", notes);
   }
-  // A submission's cases run in the sandbox where it works; where it does not, the grader says
-  // loudly what the submission can then do.
+  // A submission's kernels run as nobody (when the grader is root) and in the sandbox where it
+  // works; where it does not, the grader says loudly what the submission can then do.
   if (submission && compiled && o.sandbox != "off") {
-    const std::string bwrap = usable_bwrap();
+    const std::vector<std::string> user = as_nobody(grader.kernels);
+    const std::string bwrap = usable_bwrap(user);
     if (!bwrap.empty()) {
-      grader.sandbox = sandboxed(bwrap, grader.kernels);
+      grader.sandbox = joined(user, sandboxed(bwrap, grader.kernels));
     } else if (o.sandbox == "on") {
       fail(2, "--sandbox on: bubblewrap (bwrap) is not installed or cannot make namespaces here");
     } else {
+      grader.sandbox = joined(user, process_limit());
       std::cout << std::flush;
       std::cerr << "clothlab grade: WARNING: no sandbox (bubblewrap is not installed, or cannot "
-                   "make namespaces here): the submission's code runs as this user and can read "
-                   "and write whatever this user can, the solutions and hidden tests included. "
-                   "Install bubblewrap (Debian: apt-get install bubblewrap), or grade on a machine "
-                   "that holds nothing else.\n";
+                   "make namespaces here): the submission's code runs as "
+                << (user.empty() ? "this user" : "the user nobody")
+                << " and can read whatever that user can, the solutions and hidden tests "
+                   "included. Install bubblewrap (Debian: apt-get install bubblewrap), or grade on "
+                   "a machine that holds nothing else.\n";
     }
   }
   for (std::size_t i = 0; compiled && i < cases.size() && !g_interrupted; ++i) {

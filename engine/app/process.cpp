@@ -193,23 +193,36 @@ ProcessResult run_process(const std::vector<std::string>& args, double timeout,
   };
 
   // Read until end of file on both pipes (the case and anything it started closed them) or the
-  // deadline.
+  // deadline. Once the child has ended, whatever it left behind is ended too, and what is still in
+  // the pipes is read for at most kDrainMs: a process that kept them open cannot hold the grader
+  // to the deadline.
+  constexpr long kDrainMs = 200;
   char buffer[4096];
   Capped output(result.output, kMaxOutput);
   Capped event_lines(result.events, kMaxEvents);
   pollfd p[2] = {{fds[0], POLLIN, 0}, {event_fds[0], POLLIN, 0}};  // fd -1: ignored by poll
+  int status = 0;
+  bool ended = false;
+  auto drain_until = Clock::now();
   while (p[0].fd >= 0 || p[1].fd >= 0) {
     if (g_interrupted) {
       stop(result.interrupted);
       break;
     }
+    if (!ended && waitpid(pid, &status, WNOHANG) == pid) {
+      ended = true;
+      kill(-pid, SIGKILL);
+      end_orphans();
+      drain_until = Clock::now() + std::chrono::milliseconds(kDrainMs);
+    }
+    if (ended && Clock::now() >= drain_until) break;
     const long left = time_left_ms();
-    if (left == 0) {
+    if (left == 0 && !ended) {
       stop(result.timed_out);
       break;
     }
-    const int ready = poll(p, 2, static_cast<int>(std::min<long>(left, 1000)));
-    if (ready <= 0) continue;  // timeout slice or EINTR: check the deadline and the flag again
+    const int ready = poll(p, 2, static_cast<int>(std::min<long>(std::max(left, 1L), 20)));
+    if (ready <= 0) continue;  // a slice passed, or EINTR: check the child, deadline and flag
     for (int k = 0; k < 2; ++k) {
       if (p[k].fd < 0 || p[k].revents == 0) continue;
       const ssize_t got = read(p[k].fd, buffer, sizeof buffer);
@@ -226,9 +239,8 @@ ProcessResult run_process(const std::vector<std::string>& args, double timeout,
   close(fds[0]);
   if (events) close(event_fds[0]);
 
-  // The pipe can close before the process ends: wait for it, still under the deadline.
-  int status = 0;
-  for (;;) {
+  // The pipes can close before the process ends: wait for it, still under the deadline.
+  while (!ended) {
     const pid_t done = waitpid(pid, &status, WNOHANG);
     if (done == pid) break;
     if (done < 0 && errno != EINTR) break;

@@ -238,6 +238,14 @@ if [[ -x /usr/bin/bwrap ]] && /usr/bin/bwrap --unshare-all --ro-bind / / /bin/tr
   grade exec-reference --sandbox on
   compiled exec-reference
   expect_at_most exec-reference 0
+  # A kernel that starts 200 processes (each waits for the case to end) answers right only when
+  # fewer than 100 of them started: the sandbox's limit on processes holds.
+  mkdir -p "$work/fork-bomb"
+  patched '#include <unistd.h>' '  static int started = -1; if (started < 0) { started = 0; for (int k = 0; k < 200; ++k) { const pid_t p = fork(); if (p == 0) { pause(); _exit(0); } if (p > 0) ++started; } } return started < 100 ? Vec3(m * g) : Vec3::Zero();' \
+    >"$work/fork-bomb/$name"
+  grade fork-bomb --sandbox on
+  compiled fork-bomb
+  [[ $score == 14 ]] || problem "fork-bomb: scored $score of 14: a case started 100 processes or more"
 elif [[ ${CLOTHLAB_REQUIRE_SANDBOX:-0} == 1 ]]; then
   problem "bubblewrap is required here (CLOTHLAB_REQUIRE_SANDBOX=1) but does not work"
 else
