@@ -11,6 +11,7 @@
 // kernels run in a sandbox.
 #include "app/grade.hpp"
 #include "app/process.hpp"
+#include "app/sandbox.hpp"
 #include "app/submission.hpp"
 
 #include <fcntl.h>
@@ -482,81 +483,6 @@ std::vector<Case> list_cases(const std::string& binary) {
 }
 
 // --- The sandbox --------------------------------------------------------------------------------
-
-// True when args runs and exits 0 within 10 s.
-bool runs(const std::vector<std::string>& args) {
-  const ProcessResult probe = run_process(args, 10);
-  return !probe.timed_out && probe.signal == 0 && probe.exit_code == 0;
-}
-
-template <class... More>
-std::vector<std::string> joined(std::vector<std::string> a, const More&... more) {
-  (a.insert(a.end(), more.begin(), more.end()), ...);
-  return a;
-}
-
-// bubblewrap, when it is installed and can make namespaces here (a container may forbid it), for
-// a process started with `prefix` (as another user, say).
-std::string usable_bwrap(const std::vector<std::string>& prefix) {
-  for (const char* path : {"/usr/bin/bwrap", "/usr/local/bin/bwrap", "/bin/bwrap"}) {
-    if (access(path, X_OK) != 0) continue;
-    if (runs(joined(prefix, std::vector<std::string>{path, "--unshare-all", "--die-with-parent",
-                                                     "--ro-bind", "/", "/", "/bin/true"})))
-      return path;
-  }
-  return "";
-}
-
-// When the grader runs as root, a submission's kernels run as the user nobody (util-linux's
-// setpriv switches to it): they cannot write the grader's files, signal or read its processes,
-// and the limit on processes holds for them (the kernel exempts root from it). Empty when the
-// grader is not root, or when nobody cannot run the kernels program (a build folder under a
-// folder only root may enter).
-std::vector<std::string> as_nobody(const std::string& kernels) {
-  const std::vector<std::string> setpriv{"/usr/bin/setpriv", "--reuid=65534", "--regid=65534",
-                                         "--clear-groups"};
-  if (geteuid() != 0 || access(setpriv[0].c_str(), X_OK) != 0) return {};
-  if (!runs(joined(setpriv, std::vector<std::string>{"/usr/bin/test", "-x", kernels}))) {
-    std::cout << std::flush;
-    std::cerr << "clothlab grade: warning: the user nobody cannot run " << kernels
-              << " (a folder above it is closed to other users): the submission's kernels run as "
-                 "root.\n";
-    return {};
-  }
-  return setpriv;
-}
-
-// At most kMaxProcesses processes for the kernels program, through util-linux's prlimit. The
-// kernel counts them per user (in a sandbox's user namespace, the sandbox's own), and does not
-// hold root to the limit: see as_nobody.
-constexpr int kMaxProcesses = 64;
-std::vector<std::string> process_limit() {
-  if (access("/usr/bin/prlimit", X_OK) != 0) return {};
-  return {"/usr/bin/prlimit", fmt::format("--nproc={}", kMaxProcesses)};
-}
-
-// What runs a submission's kernels program in the sandbox: a new root that holds the system's
-// programs and libraries (read-only), /dev, /proc, an empty /tmp and the program itself, and
-// nothing of the project, its build, the grading binary, the solutions, the hidden tests, other
-// submissions or home folders; no network, no other process to see or signal (the grading binary
-// included), a session of its own (no terminal to type into), and at most kMaxProcesses processes
-// (see process_limit). Every process in it ends when the case does.
-std::vector<std::string> sandboxed(const std::string& bwrap, const std::string& binary) {
-  std::vector<std::string> args{bwrap, "--unshare-all", "--die-with-parent", "--new-session"};
-  const auto add = [&](std::initializer_list<std::string> more) { args.insert(args.end(), more); };
-  add({"--ro-bind", "/usr", "/usr"});
-  for (const char* dir : {"/lib", "/lib64", "/bin"})
-    add({"--ro-bind-try", dir, dir});  // links into /usr on most systems
-  add({"--ro-bind", "/etc", "/etc"});
-  add({"--dev", "/dev"});
-  add({"--proc", "/proc"});
-  add({"--tmpfs", "/tmp"});
-  add({"--ro-bind", binary, binary});
-  add({"--chdir", "/tmp", "--"});
-  for (const std::string& arg : process_limit())
-    args.push_back(arg);
-  return args;
-}
 
 void run_case(const Grader& grader, Case& c, double timeout) {
   if (c.name.find(',') != std::string::npos) {
@@ -1083,6 +1009,26 @@ void grade(const Options& o) {
   std::string notes;
   bool compiled = true;
   std::shared_ptr<void> hold;  // the scratch folder's lock, while its binary is graded
+  // A submission is compiled, and its kernels run, as nobody (when the grader is root) and in the
+  // sandbox where it works (sandbox.hpp); where it does not, the grader says loudly what the
+  // submission can then do.
+  Confinement confinement;
+  if (submission && o.sandbox != "off") {
+    std::string warnings;
+    confinement = confine(o.sandbox, kit_inputs(), warnings);
+    std::cout << std::flush;
+    if (!warnings.empty()) std::cerr << "clothlab grade: warning: " << warnings;
+    if (confinement.bwrap.empty() && o.sandbox == "on")
+      fail(2, "--sandbox on: bubblewrap (bwrap) is not installed or cannot make namespaces here");
+    if (confinement.bwrap.empty()) {
+      std::cerr << "clothlab grade: WARNING: no sandbox (bubblewrap is not installed, or cannot "
+                   "make namespaces here): the submission's code runs as "
+                << (confinement.user.empty() ? "this user" : "the user nobody")
+                << " and can read whatever that user can, the solutions and hidden tests "
+                   "included. Install bubblewrap (Debian: apt-get install bubblewrap), or grade on "
+                   "a machine that holds nothing else.\n";
+    }
+  }
   if (submission) {
     notes = "Submission: " + o.submission + "\n";
     write_reports(o, cases, elapsed(), notes);  // so even an interrupted build leaves results
@@ -1091,7 +1037,7 @@ void grade(const Options& o) {
     SubmissionBuild build;
     try {
       build = build_submission(o.submission, o.scratch.empty() ? default_scratch() : o.scratch,
-                               o.build_timeout);
+                               o.build_timeout, false, o.sandbox != "off" ? &confinement : nullptr);
     } catch (const std::exception& e) {
       fail(2, e.what());
     }
@@ -1113,26 +1059,7 @@ void grade(const Options& o) {
     compiled = !grader.kernels.empty();
     fmt::print("{}", notes);
   }
-  // A submission's kernels run as nobody (when the grader is root) and in the sandbox where it
-  // works; where it does not, the grader says loudly what the submission can then do.
-  if (submission && compiled && o.sandbox != "off") {
-    const std::vector<std::string> user = as_nobody(grader.kernels);
-    const std::string bwrap = usable_bwrap(user);
-    if (!bwrap.empty()) {
-      grader.sandbox = joined(user, sandboxed(bwrap, grader.kernels));
-    } else if (o.sandbox == "on") {
-      fail(2, "--sandbox on: bubblewrap (bwrap) is not installed or cannot make namespaces here");
-    } else {
-      grader.sandbox = joined(user, process_limit());
-      std::cout << std::flush;
-      std::cerr << "clothlab grade: WARNING: no sandbox (bubblewrap is not installed, or cannot "
-                   "make namespaces here): the submission's code runs as "
-                << (user.empty() ? "this user" : "the user nobody")
-                << " and can read whatever that user can, the solutions and hidden tests "
-                   "included. Install bubblewrap (Debian: apt-get install bubblewrap), or grade on "
-                   "a machine that holds nothing else.\n";
-    }
-  }
+  if (submission && o.sandbox != "off") grader.sandbox = confinement.kernels(grader.kernels);
   for (std::size_t i = 0; compiled && i < cases.size() && !g_interrupted; ++i) {
     if (cases[i].done) continue;  // not compiled
     if (colour) fmt::print("\r\033[K[{}/{}] {}", i + 1, cases.size(), cases[i].name.substr(0, 70));

@@ -19,6 +19,7 @@
 #include <system_error>
 
 #include "app/process.hpp"
+#include "app/sandbox.hpp"
 
 namespace clothlab::app {
 namespace {
@@ -311,8 +312,19 @@ std::string first_build_error(const std::string& log, int max_lines, const std::
   return "";
 }
 
+std::vector<std::string> kit_inputs() {
+  const fs::path kit = grade_kit_dir();
+  std::vector<std::string> inputs{kit.string()};
+  std::ifstream in(kit / "inputs.txt");
+  for (std::string line; std::getline(in, line);) {
+    if (!line.empty()) inputs.push_back(line);
+  }
+  return inputs;
+}
+
 SubmissionBuild build_submission(const std::string& submission_dir, const std::string& scratch_dir,
-                                 double timeout, bool stub_broken_files) {
+                                 double timeout, bool stub_broken_files,
+                                 const Confinement* confinement) {
   const fs::path kit = grade_kit_dir();
   if (!fs::exists(kit / "CMakeLists.txt")) {
     throw std::runtime_error(fmt::format(
@@ -396,6 +408,21 @@ SubmissionBuild build_submission(const std::string& submission_dir, const std::s
   // A binary left from the submission graded before must never be graded for this one.
   const fs::path binary = build / "grade-kernels";
   fs::remove(binary, ec);
+  // Nor may a confined build find another submission's objects to read: it compiles afresh.
+  std::vector<std::string> confined;
+  if (confinement != nullptr) {
+    std::vector<fs::path> objects;
+    for (auto it = fs::recursive_directory_iterator(build, ec); !ec && it != fs::end(it);
+         it.increment(ec)) {
+      const fs::path& p = it->path();
+      if (p.extension() == ".o" || p.extension() == ".a" || p.string().ends_with(".o.d"))
+        objects.push_back(p);
+    }
+    for (const fs::path& p : objects)
+      fs::remove(p, ec);
+    hand_over(*confinement, scratch.string());
+    confined = confinement->build(kit_inputs(), scratch.string());
+  }
 
   const auto shown = [&](const std::string& text) {
     return replace_all(text, exercises.string() + "/", "exercises/");
@@ -404,10 +431,13 @@ SubmissionBuild build_submission(const std::string& submission_dir, const std::s
   // changes, and the exercise files keep their names.
   const fs::path configured = build / "clothlab-configured";
   if (!fs::exists(configured, ec)) {
-    const ProcessResult configure =
-        run_process({CLOTHLAB_CMAKE_COMMAND, "-G", CLOTHLAB_CMAKE_GENERATOR, "-S", kit.string(),
-                     "-B", build.string(), "-DCLOTHLAB_EXERCISES=" + exercises.string()},
-                    timeout);
+    std::vector<std::string> args = confined;
+    for (const std::string& arg :
+         {std::string(CLOTHLAB_CMAKE_COMMAND), std::string("-G"),
+          std::string(CLOTHLAB_CMAKE_GENERATOR), std::string("-S"), kit.string(), std::string("-B"),
+          build.string(), "-DCLOTHLAB_EXERCISES=" + exercises.string()})
+      args.push_back(arg);
+    const ProcessResult configure = run_process(args, timeout);
     result.log = shown(configure.output);
     if (configure.interrupted) {
       result.first_error = "the grader was interrupted while configuring the build";
@@ -420,8 +450,10 @@ SubmissionBuild build_submission(const std::string& submission_dir, const std::s
     std::ofstream(configured) << "configured\n";
   }
   const long jobs = std::max(1L, sysconf(_SC_NPROCESSORS_ONLN));
-  std::vector<std::string> args{CLOTHLAB_CMAKE_COMMAND, "--build", build.string(), "--parallel",
-                                std::to_string(jobs)};
+  std::vector<std::string> args = confined;
+  for (const std::string& arg : {std::string(CLOTHLAB_CMAKE_COMMAND), std::string("--build"),
+                                 build.string(), std::string("--parallel"), std::to_string(jobs)})
+    args.push_back(arg);
   if (stub_broken_files) {
     for (const std::string& arg : keep_going_args())
       args.push_back(arg);

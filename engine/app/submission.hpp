@@ -15,6 +15,8 @@
 
 namespace clothlab::app {
 
+struct Confinement;
+
 struct SubmissionBuild {
   bool built = false;
   std::string binary;       // the kernels program of the submission, when built
@@ -45,8 +47,16 @@ struct SubmissionBuild {
 // that changed. With `stub_broken_files`, an exercise file that does not compile is replaced by
 // its shipped stub, so that the other files' exercises can still be graded (the student's own
 // loop); without it, one such file means no binary (a submission scores zero).
+// With `confinement` (a submission's build), the build runs confined: it sees the system, the
+// kit's inputs (kit_inputs) and the scratch folder alone, and it starts from no object of an
+// earlier build, so nothing compiled from another submission is there to read.
 SubmissionBuild build_submission(const std::string& submission_dir, const std::string& scratch_dir,
-                                 double timeout, bool stub_broken_files = false);
+                                 double timeout, bool stub_broken_files = false,
+                                 const Confinement* confinement = nullptr);
+
+// What a submission's build reads besides the system and its own files: the kit, the engine's
+// headers, and the objects of the project's build it links (grade-kit/inputs.txt).
+std::vector<std::string> kit_inputs();
 
 // Brings what the kit links (the engine, the kernels' main, the shipped stubs) and the grading
 // binary up to date, by building the target grade-kit of the project's build folder (the folder

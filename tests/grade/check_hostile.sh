@@ -238,6 +238,21 @@ if [[ -x /usr/bin/bwrap ]] && /usr/bin/bwrap --unshare-all --ro-bind / / /bin/tr
   grade exec-reference --sandbox on
   compiled exec-reference
   expect_at_most exec-reference 0
+  # The assembler reads files too, and a string split in two passes any check of the text: the
+  # compiler runs in a sandbox of its own, where the solution is not there to read.
+  mkdir -p "$work/asm-include" "$work/asm-incbin"
+  { cat "$solution"; printf 'asm(".inc" "lude \\"%s\\"");\n' "$solution"; } >"$work/asm-include/$name"
+  {
+    patched '#include <cstdio>
+extern "C" const char leaked[];' '  std::fputs(leaked, stderr); return m * g;'
+    printf 'asm(".section .rodata\\n.global leaked\\nleaked: .inc" "bin \\"%s\\"\\n.byte 0\\n.text");\n' "$solution"
+  } >"$work/asm-incbin/$name"
+  for sub in asm-include asm-incbin; do
+    grade "$sub" --sandbox on
+    expect_at_most "$sub" 0
+    grep -q -e 'no direction to pull along' -e 'such instruction: .return' "$work/$sub.out" \
+      "$work/$sub.json" && problem "$sub: the report quotes the solution"
+  done
   # A kernel that starts 200 processes (each waits for the case to end) answers right only when
   # fewer than 100 of them started: the sandbox's limit on processes holds.
   mkdir -p "$work/fork-bomb"
