@@ -109,6 +109,10 @@ if [[ $gradescope -eq 1 ]]; then
       tail -50 "$work/setup.log"
       die "setup.sh failed"
     }
+    for secret in tests/grade-hidden build/grade-cases; do
+      mode=$(stat -c %A "$root/source/clothlab/$secret")
+      [[ $mode == ????------ ]] || die "setup.sh leaves $secret open to other users ($mode)"
+    done
   else
     echo "(not root: building the autograder without its apt-get step)"
     (cd "$root/source/clothlab" && cmake -S . -B build >/dev/null &&

@@ -89,10 +89,13 @@ export DEBIAN_FRONTEND=noninteractive
 root=${AUTOGRADER_ROOT:-/autograder}
 apt-get update
 apt-get install -y --no-install-recommends g++ cmake make libeigen3-dev doctest-dev libfmt-dev \
-  libtomlplusplus-dev libcli11-dev
+  libtomlplusplus-dev libcli11-dev bubblewrap
 cd "$root/source/clothlab"
 cmake -S . -B build
 cmake --build build --parallel "$(nproc)" --target clothlab grade-kit
+# A submission's code runs as the user nobody (and in a sandbox where the container allows one):
+# the hidden tests' sources and the grading binary that holds them are root's alone.
+chmod -R go-rwx tests/grade-hidden build/grade-cases 2>/dev/null || true
 ]=])
 file(WRITE ${OUT}/run_autograder [=[#!/usr/bin/env bash
 # Gradescope runs this for every submission: it grades the exercise files in
