@@ -76,6 +76,8 @@ class Kernels {
       if (broke != nullptr) {
         gone_ =
             std::string("the exercise's code broke the kernels' protocol (") + broke + ")" + during;
+      } else if (code == 127) {
+        gone_ = "the kernels program (CLOTHLAB_KERNELS) could not be started" + during;
       } else if (signal != 0) {
         gone_ = "crashed: signal " + std::to_string(signal) +
                 " (in the exercise's code, which runs in a process of its own," + during + ")";
