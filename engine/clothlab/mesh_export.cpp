@@ -23,7 +23,7 @@ std::vector<SpringView> all_springs(const World& world) {
     if (const auto* s = dynamic_cast<const SpringDampers*>(effect.get())) {
       const SpringSet& set = s->springs();
       for (size_t k = 0; k < set.size(); ++k)
-        springs.push_back({set.i[k], set.j[k], set.l0[k]});
+        springs.push_back({set.i(k), set.j(k), set.l0(k)});
     }
   }
   return springs;

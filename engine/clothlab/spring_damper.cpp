@@ -12,12 +12,12 @@
 namespace clothlab {
 
 void SpringSet::add(Index a, Index b, double ks_ab, double kd_ab, double l0_ab, const Matrix3X& x) {
-  i.push_back(a);
-  j.push_back(b);
-  ks.push_back(ks_ab);
-  kd.push_back(kd_ab);
-  l0.push_back(l0_ab >= 0.0 ? l0_ab : (x.col(b) - x.col(a)).norm());
-  l_built.push_back(l0.back());
+  i_.push_back(a);
+  j_.push_back(b);
+  ks_.push_back(ks_ab);
+  kd_.push_back(kd_ab);
+  l0_.push_back(l0_ab >= 0.0 ? l0_ab : (x.col(b) - x.col(a)).norm());
+  l_built_.push_back(l0_.back());
   changed();
 }
 
@@ -29,28 +29,51 @@ void SpringSet::erase(const std::vector<size_t>& positions) {
       ++next;
       continue;
     }
-    i[kept] = i[k];
-    j[kept] = j[k];
-    ks[kept] = ks[k];
-    kd[kept] = kd[k];
-    l0[kept] = l0[k];
-    l_built[kept] = l_built[k];
+    i_[kept] = i_[k];
+    j_[kept] = j_[k];
+    ks_[kept] = ks_[k];
+    kd_[kept] = kd_[k];
+    l0_[kept] = l0_[k];
+    l_built_[kept] = l_built_[k];
     ++kept;
   }
-  ks.resize(kept);
-  kd.resize(kept);
-  l0.resize(kept);
-  l_built.resize(kept);
-  i.resize(kept);
-  j.resize(kept);
+  for (auto* column : {&ks_, &kd_, &l0_, &l_built_})
+    column->resize(kept);
+  i_.resize(kept);
+  j_.resize(kept);
+  changed();
+}
+
+void SpringSet::set_ends(size_t k, Index a, Index b) {
+  i_[k] = a;
+  j_[k] = b;
+  changed();
+}
+
+void SpringSet::reverse() {
+  for (auto* column : {&ks_, &kd_, &l0_, &l_built_})
+    std::reverse(column->begin(), column->end());
+  std::reverse(i_.begin(), i_.end());
+  std::reverse(j_.begin(), j_.end());
+  std::swap(i_, j_);
+  changed();
+}
+
+void SpringSet::set_ks(size_t k, double value) {
+  ks_[k] = value;
+  changed();
+}
+
+void SpringSet::set_kd(size_t k, double value) {
+  kd_[k] = value;
   changed();
 }
 
 void SpringSet::changed() {
-  // One counter for every set: two sets never share a generation unless one is a copy of the
-  // other (and then their i and j are the same too).
+  // One counter for every set: two sets never share a version unless one is a copy of the other
+  // (and then their ends and constants are the same too).
   static std::atomic<unsigned long> changes{0};
-  generation = ++changes;
+  version_ = ++changes;
 }
 
 namespace {
@@ -69,14 +92,14 @@ std::vector<SpringRun> spring_runs(const SpringSet& s) {
     // Spring k continues the last run if it joins the particles just after its last spring's.
     if (!runs.empty()) {
       SpringRun& last = runs.back();
-      if (s.i[k] == last.i0 + last.length && s.j[k] == last.j0 + last.length) {
+      if (s.i(k) == last.i0 + last.length && s.j(k) == last.j0 + last.length) {
         last.uniform =
-            last.uniform && same_bits(s.ks[k], s.ks[last.k0]) && same_bits(s.kd[k], s.kd[last.k0]);
+            last.uniform && same_bits(s.ks(k), s.ks(last.k0)) && same_bits(s.kd(k), s.kd(last.k0));
         ++last.length;
         continue;
       }
     }
-    runs.push_back({k, s.i[k], s.j[k], 1, true});
+    runs.push_back({k, s.i(k), s.j(k), 1, true});
   }
   return runs;
 }
@@ -108,9 +131,9 @@ void SpringDampers::add_forces(const Particles& /*p*/, const Matrix3X& x, const 
                                Matrix3X& f) const {
   const SpringSet& s = springs_;
   for (size_t k = 0; k < s.size(); ++k) {
-    const Index a = s.i[k], b = s.j[k];
+    const Index a = s.i(k), b = s.j(k);
     const Vec3 f1 =
-        spring_damper_force(x.col(a), x.col(b), v.col(a), v.col(b), s.ks[k], s.kd[k], s.l0[k]);
+        spring_damper_force(x.col(a), x.col(b), v.col(a), v.col(b), s.ks(k), s.kd(k), s.l0(k));
     f.col(a) += f1;  // f2 = -f1: what pulls one end pushes the other
     f.col(b) -= f1;
   }
@@ -279,15 +302,11 @@ void add_both_shares(Index count, Index n, Index gap, const double* __restrict f
 bool SpringDampers::adds_soa(const Particles& /*p*/) const {
   RunLayout& lay = layout_;
   const SpringSet& s = springs_;
-  if (lay.generation != s.generation || lay.springs != s.size() ||
-      lay.ks_changes != s.ks.changes() || lay.kd_changes != s.kd.changes()) {
-    lay.generation = s.generation;
-    lay.springs = s.size();
-    lay.ks_changes = s.ks.changes();
-    lay.kd_changes = s.kd.changes();
+  if (!lay.built || lay.version != s.version()) {
+    lay.built = true;
+    lay.version = s.version();
     lay.runs = spring_runs(s);
   }
-  assert(lay.runs == spring_runs(s) && "i or j changed in place without SpringSet::changed()");
   // Runs of a few springs cost more in bookkeeping than they save: such a set (springs given
   // one by one, or shuffled) is evaluated by add_forces.
   constexpr size_t kMinMeanRun = 8;
@@ -316,8 +335,8 @@ void SpringDampers::add_run(const SpringRun& run, Index p_begin, Index p_end, co
     const Index k = static_cast<Index>(run.k0) + c0;
     spring_forces_of_run(c1 - c0, x.cols(), v.cols(), x.data() + run.i0 + c0,
                          x.data() + run.j0 + c0, v.data() + run.i0 + c0, v.data() + run.j0 + c0,
-                         springs_.ks.data() + k, springs_.kd.data() + k, springs_.l0.data() + k, f1,
-                         f1 + kChunk, f1 + 2 * kChunk, run.uniform);
+                         springs_.ks().data() + k, springs_.kd().data() + k,
+                         springs_.l0().data() + k, f1, f1 + kChunk, f1 + 2 * kChunk, run.uniform);
     // Springs [u0, u1) of the chunk give upper ends their shares, [l0, l1) lower ends theirs.
     // Upper end upper + t is lower end lower + t + gap: where both fall in this chunk, that
     // particle takes both at once (upper first); the others take theirs one pass at a time.
@@ -375,8 +394,8 @@ void SpringDampers::add_run_direct(const SpringRun& run, Index up_begin, Index u
            run_kernel_direct<true, true, true, true>}}}};
     kernels[run.uniform][upper_is_j][to_upper][to_lower](
         t1 - t0, x.cols(), v.cols(), f.cols(), x.data() + run.i0 + t0, x.data() + run.j0 + t0,
-        v.data() + run.i0 + t0, v.data() + run.j0 + t0, springs_.ks.data() + k,
-        springs_.kd.data() + k, springs_.l0.data() + k, f.data() + upper + t0,
+        v.data() + run.i0 + t0, v.data() + run.j0 + t0, springs_.ks().data() + k,
+        springs_.kd().data() + k, springs_.l0().data() + k, f.data() + upper + t0,
         f.data() + lower + t0);
   };
   // Spring t has its upper end in range for t in [up_begin, up_end) and its lower end for t in
@@ -398,7 +417,7 @@ double SpringDampers::potential_energy(const Particles& /*p*/, const Matrix3X& x
   const SpringSet& s = springs_;
   double energy = 0.0;
   for (size_t k = 0; k < s.size(); ++k) {
-    energy += spring_energy(x.col(s.i[k]), x.col(s.j[k]), s.ks[k], s.l0[k]);
+    energy += spring_energy(x.col(s.i(k)), x.col(s.j(k)), s.ks(k), s.l0(k));
   }
   return energy;
 }
@@ -419,8 +438,8 @@ bool SpringDampers::add_jacobians(const Particles& /*p*/, const Matrix3X& x, con
   const SpringSet& s = springs_;
   for (size_t k = 0; k < s.size(); ++k) {
     const SpringJacobian jac =
-        spring_damper_jacobian(x.col(s.i[k]), x.col(s.j[k]), s.ks[k], s.kd[k], s.l0[k]);
-    jacobians.add_pair(s.i[k], s.j[k], jac.dfdx, jac.dfdv);
+        spring_damper_jacobian(x.col(s.i(k)), x.col(s.j(k)), s.ks(k), s.kd(k), s.l0(k));
+    jacobians.add_pair(s.i(k), s.j(k), jac.dfdx, jac.dfdv);
   }
   return true;
 }

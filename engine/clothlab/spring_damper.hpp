@@ -49,102 +49,55 @@ Vec3 spring_damper_force(const Vec3& r1, const Vec3& r2, const Vec3& v1, const V
 // Exercise 2.2: the energy [J] stored in the spring (not the damper), 1/2 ks (l - l0)^2.
 double spring_energy(const Vec3& r1, const Vec3& r2, double ks, double l0);
 
-// Per-spring constants (a SpringSet's ks and kd) that count their changes. The fast path keeps
-// one value for a run of springs that all share it (SpringRun::uniform), so that it need not read
-// the same number once per spring; the count tells it when the values may have changed. It reads
-// and writes like a std::vector<double> (c[k], size, push_back), except that on a non-const
-// column c[k] is a Ref, not a double&: assigning to it counts as a change, and no reference can
-// outlive the count. A loop over every value goes through edit().
-class SpringColumn {
- public:
-  class Ref {
-   public:
-    Ref& operator=(double value) {
-      column_->values_[k_] = value;
-      ++column_->changes_;
-      return *this;
-    }
-    Ref& operator=(const Ref& other) { return *this = static_cast<double>(other); }
-    Ref(const Ref&) = default;
-    operator double() const { return column_->values_[k_]; }
-
-   private:
-    friend class SpringColumn;
-    Ref(SpringColumn* column, size_t k) : column_(column), k_(k) {}
-    SpringColumn* column_;
-    size_t k_;
-  };
-
-  SpringColumn() = default;
-  SpringColumn(const SpringColumn&) = default;
-  SpringColumn(SpringColumn&&) = default;
-  // Assigning a whole column is a change too, whatever the two counts were.
-  SpringColumn& operator=(const SpringColumn& other) {
-    values_ = other.values_;
-    changes_ = std::max(changes_, other.changes_) + 1;
-    return *this;
-  }
-  SpringColumn& operator=(SpringColumn&& other) noexcept {
-    values_ = std::move(other.values_);
-    changes_ = std::max(changes_, other.changes_) + 1;
-    return *this;
-  }
-
-  double operator[](size_t k) const { return values_[k]; }
-  Ref operator[](size_t k) { return Ref(this, k); }
-  size_t size() const { return values_.size(); }
-  double back() const { return values_.back(); }
-  const double* data() const { return values_.data(); }
-  const std::vector<double>& values() const { return values_; }
-  void push_back(double value) {
-    values_.push_back(value);
-    ++changes_;
-  }
-  void resize(size_t n) {
-    values_.resize(n);
-    ++changes_;
-  }
-  void assign(size_t n, double value) {
-    values_.assign(n, value);
-    ++changes_;
-  }
-  // The values themselves, for changing many at once (reversing, sorting), counted as a change.
-  // Finish with the reference before the next force evaluation: changes made through it after
-  // that are not counted.
-  std::vector<double>& edit() {
-    ++changes_;
-    return values_;
-  }
-  // How many changes this column has seen, copies included.
-  unsigned long changes() const { return changes_; }
-
- private:
-  std::vector<double> values_;
-  unsigned long changes_ = 0;
-};
-
-// A family of springs as parallel arrays: spring k joins particles i[k] and j[k].
+// A family of springs as parallel arrays: spring k joins particles i(k) and j(k), with spring
+// constant ks(k) [N/m], damping factor kd(k) [N s/m], rest length l0(k) [m] and its rest length
+// as built, l_built(k) [m] (plasticity, lesson 06, keeps l0 within limits of l_built).
 //
-// The fast path (fast_forces.hpp) keeps a description of i and j as runs (see SpringRun), built
-// again whenever `generation` changes, or ks or kd change (SpringColumn counts their changes).
-// add() and erase() set `generation` to a number no other change, of any set, has had; code that
-// edits i or j in place, or builds a set by push_back, calls changed() afterwards. ks and kd may
-// be changed in place, and l0 freely (plasticity changes it every step): the runs hold no l0.
-struct SpringSet {
-  std::vector<Index> i, j;
-  SpringColumn ks;               // spring constants [N/m]
-  SpringColumn kd;               // damping factors [N s/m]
-  std::vector<double> l0;        // rest lengths [m]; plasticity (lesson 06) may change them
-  std::vector<double> l_built;   // rest lengths as built [m], for plastic strain limits
-  unsigned long generation = 0;  // which change to i and j this set is at (see above)
+// The arrays are read through i(), j(), ks(), ... and changed only through the methods below.
+// The fast path keeps a description of the ends and the constants (see SpringRun), and every
+// method that changes one of them moves version() to a number no other change, of any set, has
+// had: the fast path compares it before every use, in every build, so it never computes with a
+// description of springs that are no longer there. The rest lengths change freely (plasticity
+// changes them every step): no description holds them.
+class SpringSet {
+ public:
+  size_t size() const { return i_.size(); }
 
-  size_t size() const { return i.size(); }
+  Index i(size_t k) const { return i_[k]; }
+  Index j(size_t k) const { return j_[k]; }
+  double ks(size_t k) const { return ks_[k]; }
+  double kd(size_t k) const { return kd_[k]; }
+  double l0(size_t k) const { return l0_[k]; }
+  double l_built(size_t k) const { return l_built_[k]; }
+  const std::vector<Index>& i() const { return i_; }
+  const std::vector<Index>& j() const { return j_; }
+  const std::vector<double>& ks() const { return ks_; }
+  const std::vector<double>& kd() const { return kd_; }
+  const std::vector<double>& l0() const { return l0_; }
+  const std::vector<double>& l_built() const { return l_built_; }
+
   // Adds a spring from a to b; l0 < 0 means "the distance between them in x".
   void add(Index a, Index b, double ks_ab, double kd_ab, double l0_ab, const Matrix3X& x);
   // Removes the springs at the given positions (ascending), keeping the others in order.
   void erase(const std::vector<size_t>& positions);
-  // Says that i or j were changed in place: layouts built from them are out of date.
+  // Spring k now joins a and b (its constants and lengths stay).
+  void set_ends(size_t k, Index a, Index b);
+  // The springs in the opposite order, each turned end for end: the same forces, summed in
+  // another order.
+  void reverse();
+  void set_ks(size_t k, double value);
+  void set_kd(size_t k, double value);
+  void set_l0(size_t k, double value) { l0_[k] = value; }
+
+  // Which change of the ends or the constants this set is at (see above).
+  unsigned long version() const { return version_; }
+
+ private:
   void changed();
+
+  std::vector<Index> i_, j_;
+  std::vector<double> ks_, kd_, l0_, l_built_;
+  unsigned long version_ = 0;
 };
 
 // A stretch of springs that join consecutive particles: springs k0, k0 + 1, ..., k0 + length - 1
@@ -225,11 +178,10 @@ class SpringDampers final : public ForceEffect {
   std::string name_;
   SpringSet springs_;
 
-  // The fast path's view of springs_, built again when springs_.generation changes.
+  // The fast path's view of springs_, built again when springs_.version() changes.
   struct RunLayout {
-    unsigned long generation = 0;
-    size_t springs = 0;
-    unsigned long ks_changes = 0, kd_changes = 0;  // SpringColumn::changes() when built
+    bool built = false;
+    unsigned long version = 0;
     std::vector<SpringRun> runs;
   };
   mutable RunLayout layout_;

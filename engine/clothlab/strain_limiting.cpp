@@ -16,14 +16,14 @@ void StrainLimiting::apply(World& world, double dt) {
     // Gauss-Seidel: each spring sees the corrections of the springs before it in this sweep.
     bool corrected = false;  // some spring was past its limit by more than rounding
     for (size_t k = 0; k < s.size(); ++k) {
-      const Index i = s.i[k], j = s.j[k];
+      const Index i = s.i(k), j = s.j(k);
       const StrainCorrection c =
-          strain_limit_correction(p.x.col(i), p.x.col(j), p.inv_m[i], p.inv_m[j], s.l0[k], limits_);
+          strain_limit_correction(p.x.col(i), p.x.col(j), p.inv_m[i], p.inv_m[j], s.l0(k), limits_);
       // dr1 - dr2 = C e, whatever the split, so |dr1 - dr2| = |C| is how far the spring was past
       // its limit [m]. Most springs are within it, C = 0, and cost nothing more.
       const double excess = (c.dr1 - c.dr2).norm();
       if (excess == 0.0) continue;
-      corrected = corrected || excess > kTolerance * s.l0[k];
+      corrected = corrected || excess > kTolerance * s.l0(k);
       p.x.col(i) += c.dr1;
       p.x.col(j) += c.dr2;
       // v += dr / dt: the velocity stays the particle's displacement over the step.

@@ -17,8 +17,8 @@ void Tearing::apply(World& world, double /*dt*/) {
   std::vector<double> strain(s.size());
   std::vector<std::pair<Index, Index>> ends(s.size());
   for (size_t k = 0; k < s.size(); ++k) {
-    strain[k] = (x.col(s.j[k]) - x.col(s.i[k])).norm() / s.l0[k] - 1.0;
-    ends[k] = {std::min(s.i[k], s.j[k]), std::max(s.i[k], s.j[k])};
+    strain[k] = (x.col(s.j(k)) - x.col(s.i(k))).norm() / s.l0(k) - 1.0;
+    ends[k] = {std::min(s.i(k), s.j(k)), std::max(s.i(k), s.j(k))};
   }
   std::vector<size_t> torn = select_tears(strain, ends, tear_strain_, max_tears_);
   if (torn.empty()) return;
@@ -53,7 +53,7 @@ void Tearing::apply(World& world, double /*dt*/) {
     SpringSet& b = bending->springs();
     std::vector<size_t> spanning;
     for (size_t k = 0; k < b.size(); ++k) {
-      const Index a = std::min(b.i[k], b.j[k]), c = std::max(b.i[k], b.j[k]);
+      const Index a = std::min(b.i(k), b.j(k)), c = std::max(b.i(k), b.j(k));
       if ((a + c) % 2 != 0) continue;
       const Index m = (a + c) / 2;
       if (gone.count({a, m}) != 0 || gone.count({m, c}) != 0) spanning.push_back(k);

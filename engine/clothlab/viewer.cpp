@@ -75,8 +75,8 @@ void ViewerRecorder::write(const World& world, const std::filesystem::path& html
   for (const auto& effect : world.force_effects) {
     if (const auto* s = dynamic_cast<const SpringDampers*>(effect.get())) {
       for (size_t k = 0; k < s->springs().size(); ++k) {
-        springs.push_back(s->springs().i[k]);
-        springs.push_back(s->springs().j[k]);
+        springs.push_back(s->springs().i(k));
+        springs.push_back(s->springs().j(k));
       }
     }
   }

@@ -56,7 +56,7 @@ void remove_effect(Effects& effects, std::string_view name) {
 Ends end_pairs(const SpringSet& s) {
   Ends ends;
   for (size_t k = 0; k < s.size(); ++k)
-    ends.insert({std::min(s.i[k], s.j[k]), std::max(s.i[k], s.j[k])});
+    ends.insert({std::min(s.i(k), s.j(k)), std::max(s.i(k), s.j(k))});
   return ends;
 }
 
@@ -120,8 +120,8 @@ std::pair<double, double> column(Scene& scene) {
   double rest = 0.0;
   const SpringSet& s = springs_of(w);
   for (size_t k = 0; k < s.size(); ++k) {
-    const Index lo = std::min(s.i[k], s.j[k]), hi = std::max(s.i[k], s.j[k]);
-    if ((lo - mid) % cols == 0 && hi == lo + cols) rest += s.l0[k];
+    const Index lo = std::min(s.i(k), s.j(k)), hi = std::max(s.i(k), s.j(k));
+    if ((lo - mid) % cols == 0 && hi == lo + cols) rest += s.l0(k);
   }
   return {w.particles.x(1, mid) - w.particles.x(1, mid + (rows - 1) * cols), rest};
 }
@@ -171,13 +171,7 @@ void order_independence() {
   Scene as_built = load_scene_file(lesson_file("tearing-sheet.toml"));
   Scene reversed = load_scene_file(lesson_file("tearing-sheet.toml"));
   SpringSet& s = springs_of(reversed.world);
-  // ks and kd count their changes (SpringColumn, spring_damper.hpp): edit() hands out their
-  // values for a change to all of them, and tells the engine's fast path to look again.
-  for (std::vector<double>* v : {&s.ks.edit(), &s.kd.edit(), &s.l0, &s.l_built})
-    std::reverse(v->begin(), v->end());
-  std::reverse(s.i.begin(), s.i.end());
-  std::reverse(s.j.begin(), s.j.end());
-  std::swap(s.i, s.j);  // and every spring turned end for end
+  s.reverse();  // the list in the opposite order, and every spring turned end for end
   for (long n = 0; n < as_built.step_count(); ++n) {
     as_built.world.step(as_built.dt);
     reversed.world.step(reversed.dt);

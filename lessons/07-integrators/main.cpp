@@ -100,7 +100,7 @@ Oscillator oscillator_of(Scene& scene) {
   const SpringSet& s = springs_of(scene.world);
   const double m = scene.world.particles.m[1];
   const double l = (scene.world.particles.x.col(1) - scene.world.particles.x.col(0)).norm();
-  return Oscillator{m, s.ks[0], s.kd[0], s.l0[0], l - s.l0[0]};
+  return Oscillator{m, s.ks(0), s.kd(0), s.l0(0), l - s.l0(0)};
 }
 
 // --- 1. Order ----------------------------------------------------------------------------------
@@ -160,10 +160,10 @@ Scene long_spring(std::string_view method, bool damped) {
   SpringSet& s = springs_of(scene.world);
   Particles& p = scene.world.particles;
   const Vec3 e = (p.x.col(1) - p.x.col(0)).normalized();
-  const double stretch = (p.x.col(1) - p.x.col(0)).norm() - s.l0[0];
-  s.l0[0] = 1000.0;  // [m]
-  p.x.col(1) = p.x.col(0) + (s.l0[0] + stretch) * e;
-  if (!damped) s.kd[0] = 0.0;
+  const double stretch = (p.x.col(1) - p.x.col(0)).norm() - s.l0(0);
+  s.set_l0(0, 1000.0);  // [m]
+  p.x.col(1) = p.x.col(0) + (s.l0(0) + stretch) * e;
+  if (!damped) s.set_kd(0, 0.0);
   return scene;
 }
 
@@ -347,8 +347,8 @@ void stiff_run(const char* label, std::string_view method, double dt, double tol
       w.step(dt);
       wall += std::chrono::duration<double>(Clock::now() - start).count();
       for (size_t k = 0; k < s.size(); ++k) {
-        const double l = (w.particles.x.col(s.j[k]) - w.particles.x.col(s.i[k])).norm();
-        strain = std::max(strain, (l - s.l0[k]) / s.l0[k]);
+        const double l = (w.particles.x.col(s.j(k)) - w.particles.x.col(s.i(k))).norm();
+        strain = std::max(strain, (l - s.l0(k)) / s.l0(k));
       }
       const double z = w.particles.x(2, corner);
       if (z < z_low) {
@@ -376,7 +376,7 @@ void stiff_cloth() {
   fmt::print(
       "5. stiff-cloth.toml: {} particles, ks = {:g} N/m, {:g} s, one force evaluation a step.\n"
       "   The far free corner starts at z = 0.7 m, swings out and comes back: z [m] (at t [s])\n",
-      scene.world.particles.size(), springs_of(scene.world).ks[0], scene.duration);
+      scene.world.particles.size(), springs_of(scene.world).ks(0), scene.duration);
   fmt::print("   {:<26}  {:>6}  {:>8}  {:>8}  {:>7}  {:>14}  {:>14}\n", "method, dt", "steps",
              "CG iter.", "wall [s]", "stretch", "first swing", "and back");
   stiff_run("symplectic-euler, 10 ms", "symplectic-euler", 0.01, tolerance);

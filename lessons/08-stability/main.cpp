@@ -426,8 +426,8 @@ void stiffest_mode(bool dense) {
   Scene scene = load_scene_file(lesson_file("stiff-sheet.toml"));
   const World& w = scene.world;
   const SpringSet& s = find_spring_effect(scene.world, "springs")->springs();
-  const double m = w.particles.m[0];                  // [kg], the same for every particle
-  const double ks = s.ks[0], shear_ks = s.ks.back();  // [N/m]: structural first, shear last
+  const double m = w.particles.m[0];                    // [kg], the same for every particle
+  const double ks = s.ks(0), shear_ks = s.ks().back();  // [N/m]: structural first, shear last
   Clock::time_point start = Clock::now();
   const StiffnessBounds b = stiffness_bounds(w);
   const double bound_time = seconds_since(start);
@@ -510,8 +510,8 @@ void sheet_run(const char* file, const char* label) {
         next_sample += 0.5;
         z_at.push_back(w.particles.x(2, corner));
         for (size_t k = 0; k < s.size(); ++k) {
-          const double l = (w.particles.x.col(s.j[k]) - w.particles.x.col(s.i[k])).norm();
-          stretch = std::max(stretch, l / s.l0[k] - 1.0);
+          const double l = (w.particles.x.col(s.j(k)) - w.particles.x.col(s.i(k))).norm();
+          stretch = std::max(stretch, l / s.l0(k) - 1.0);
         }
       }
     }

@@ -58,8 +58,8 @@ double max_strain(World& world) {
   const SpringSet& s = springs_of(world);
   double worst = -1.0;
   for (size_t k = 0; k < s.size(); ++k) {
-    const double l = (world.particles.x.col(s.j[k]) - world.particles.x.col(s.i[k])).norm();
-    worst = std::max(worst, l / s.l0[k] - 1.0);
+    const double l = (world.particles.x.col(s.j(k)) - world.particles.x.col(s.i(k))).norm();
+    worst = std::max(worst, l / s.l0(k) - 1.0);
   }
   return worst;
 }
@@ -113,9 +113,9 @@ struct Hanging {
 Hanging hang(int sweeps, double stiffer, double dt) {
   Scene scene = load_scene_file(lesson_file("sagging-cloth.toml"));
   World& w = scene.world;
-  // edit(): every spring constant at once, a change the fast path is told of (SpringColumn).
-  for (double& ks : springs_of(w).ks.edit())
-    ks *= stiffer;
+  SpringSet& springs = springs_of(w);
+  for (size_t k = 0; k < springs.size(); ++k)
+    springs.set_ks(k, stiffer * springs.ks(k));
   if (sweeps > 0)
     w.post_step_effects.push_back(std::make_unique<StrainLimiting>(StrainLimits{0.1, 1.0}, sweeps));
   const long steps = std::lround(scene.duration / dt);
@@ -155,8 +155,9 @@ void hanging_cloth() {
   // step that stiffness needs.
   const double factor = soft.strain / 0.1;
   Scene stiff = load_scene_file(lesson_file("sagging-cloth.toml"));
-  for (double& ks : springs_of(stiff.world).ks.edit())
-    ks *= factor;
+  SpringSet& s = springs_of(stiff.world);
+  for (size_t k = 0; k < s.size(); ++k)
+    s.set_ks(k, factor * s.ks(k));
   const double dt_stiff = advise_time_step(stiff.world, dt, stiff.step_count()).dt_limit;
   const double dt_run = std::min(dt, 0.9 * dt_stiff);
   row(fmt::format("stiff springs, ks = {:.0f} N/m", 10.0 * factor), hang(0, factor, dt_run));

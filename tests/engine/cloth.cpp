@@ -110,7 +110,7 @@ TEST_CASE("cloth: a grid has the spring counts the lecture's pictures give") {
   CHECK(bending.size() == 240);
   CHECK(scene.world.triangles.size() == 2 * 11 * 11);
   // Rest lengths are the build-time distances: 4 cm, 4 cm * sqrt(2) and 8 cm.
-  for (double l0 : bending.l0)
+  for (double l0 : bending.l0())
     CHECK(l0 == doctest::Approx(0.08));
 }
 

@@ -73,7 +73,9 @@ double total_energy(const clothlab::World& world) {
 // an explicit method is stable for dt below about 2 / w_max (symplectic Euler's limit for a
 // linear spring of frequency w); with kd it bounds the fastest damping rate [1/s]. Every spring
 // effect counts ("springs" and "bending"). The bound may overestimate, never underestimate.
-double spring_bound(const clothlab::World& world, clothlab::SpringColumn clothlab::SpringSet::*c) {
+// `c` picks spring k's constant from a set: its ks or its kd.
+template <class Constant>
+double spring_bound(const clothlab::World& world, Constant c) {
   const clothlab::Particles& p = world.particles;
   std::vector<double> sum(static_cast<size_t>(p.size()), 0.0);
   for (const auto& effect : world.force_effects) {
@@ -81,8 +83,8 @@ double spring_bound(const clothlab::World& world, clothlab::SpringColumn clothla
     if (!springs) continue;
     const clothlab::SpringSet& s = springs->springs();
     for (size_t k = 0; k < s.size(); ++k) {
-      const Index i = s.i[k], j = s.j[k];
-      const double c_k = (s.*c)[k];
+      const Index i = s.i(k), j = s.j(k);
+      const double c_k = c(s, k);
       const double cross = c_k / std::sqrt(p.m[i] * p.m[j]);
       sum[static_cast<size_t>(i)] += c_k / p.m[i] + cross;
       sum[static_cast<size_t>(j)] += c_k / p.m[j] + cross;
@@ -96,7 +98,8 @@ double spring_bound(const clothlab::World& world, clothlab::SpringColumn clothla
 }
 
 double w_max_bound(const clothlab::World& world) {
-  return std::sqrt(spring_bound(world, &clothlab::SpringSet::ks));
+  return std::sqrt(
+      spring_bound(world, [](const clothlab::SpringSet& s, size_t k) { return s.ks(k); }));
 }
 
 const clothlab::Aerodynamics& aerodynamics_of(const clothlab::World& world) {
@@ -798,12 +801,8 @@ TEST_CASE("hard case: a tearing cascade tears the same springs whatever their or
   const auto permute = [](clothlab::SpringSet& s, const std::vector<size_t>& order) {
     clothlab::SpringSet out;
     for (size_t k : order) {
-      out.i.push_back(s.i[k]);
-      out.j.push_back(s.j[k]);
-      out.ks.push_back(s.ks[k]);
-      out.kd.push_back(s.kd[k]);
-      out.l0.push_back(s.l0[k]);
-      out.l_built.push_back(s.l_built[k]);
+      REQUIRE(s.l_built(k) == s.l0(k));  // as built: add() gives l_built = l0
+      out.add(s.i(k), s.j(k), s.ks(k), s.kd(k), s.l0(k), clothlab::Matrix3X());
     }
     s = out;
   };
@@ -820,7 +819,7 @@ TEST_CASE("hard case: a tearing cascade tears the same springs whatever their or
     std::shuffle(order.begin(), order.end(), random);
     permute(s, order);
     for (size_t k = 0; k < s.size(); k += 2)
-      std::swap(s.i[k], s.j[k]);
+      s.set_ends(k, s.j(k), s.i(k));
   });
   CHECK(as_built.size() > 50);  // a cascade, not one spring
   CHECK(reversed == as_built);
@@ -896,14 +895,14 @@ duration = 20
   clothlab::World& world = scene.world;
   world.force_effects.push_back(std::make_unique<CyclicLoad>(world, 1, 60.0, 20.0, 2.0));
   const clothlab::SpringSet& s = test::springs_of(world);
-  const double l_built = s.l_built[0];
+  const double l_built = s.l_built(0);
   const double lowest = l_built * (1.0 - 0.3), highest = l_built * (1.0 + 0.3);
   double l0_min = l_built, l0_max = l_built;
   int reached_top = 0, reached_bottom = 0;
   bool at_top = false, at_bottom = false;
   for (long step = 0; step < scene.step_count(); ++step) {
     world.step(scene.dt);
-    const double l0 = s.l0[0];
+    const double l0 = s.l0(0);
     CAPTURE(step);
     REQUIRE(std::isfinite(l0));
     REQUIRE(l0 >= lowest);
@@ -1026,7 +1025,8 @@ TEST_CASE("hard case: a seeded random scene runs 10^5 symplectic Euler steps and
   clothlab::Scene scene = scene_with(text, "symplectic-euler");
   clothlab::World& world = scene.world;
   const double c_max =
-      spring_bound(world, &clothlab::SpringSet::kd) + 1.0 + 1.225 * 1.5 * 10.0 * 2.0 / density;
+      spring_bound(world, [](const clothlab::SpringSet& s, size_t k) { return s.kd(k); }) + 1.0 +
+      1.225 * 1.5 * 10.0 * 2.0 / density;
   const double dt = 0.25 * std::min(2.0 / w_max_bound(world), 1.0 / c_max);
   CAPTURE(dt);
   const long steps = 100000;
@@ -1094,7 +1094,7 @@ duration = 0.5
     }
     CHECK(same_bits(a.world.particles.x, b.world.particles.x));
     CHECK(same_bits(a.world.particles.v, b.world.particles.v));
-    CHECK(test::springs_of(a.world).l0 == test::springs_of(b.world).l0);
+    CHECK(test::springs_of(a.world).l0() == test::springs_of(b.world).l0());
     // The run did something: the cloth moved away from where it was built.
     clothlab::Scene c = scene_with(text, method);
     CHECK((a.world.particles.x - c.world.particles.x).colwise().norm().maxCoeff() > 0.05);

@@ -403,7 +403,7 @@ TEST_CASE("integrators: implicit Euler counts the solves that stop at max_iterat
   World world = free_cloth("implicit-euler", 5, 5);
   clothlab::SpringSet& s = clothlab::find_spring_effect(world, "springs")->springs();
   for (size_t k = 0; k < s.size(); ++k)
-    s.ks[k] = 1e4;
+    s.set_ks(k, 1e4);
   world.force_effects.push_back(std::make_unique<clothlab::UniformGravity>(Vec3(0.0, -9.8, 0.0)));
   clothlab::pin(world.particles, 0);
   clothlab::pin(world.particles, 4);
@@ -430,7 +430,7 @@ TEST_CASE("integrators: implicit Euler counts the solves that stop at max_iterat
   enough->max_iterations = 500;
   clothlab::SpringSet& s2 = clothlab::find_spring_effect(converged, "springs")->springs();
   for (size_t k = 0; k < s2.size(); ++k)
-    s2.ks[k] = 1e4;
+    s2.set_ks(k, 1e4);
   converged.particles.x(2, 12) += 0.05;
   for (int step = 0; step < n; ++step)
     converged.step(0.01);

@@ -29,8 +29,8 @@ double total_excess(const clothlab::World& world) {
   const clothlab::SpringSet& s = test::springs_of(world);
   double sum = 0.0;
   for (size_t k = 0; k < s.size(); ++k) {
-    const double l = (world.particles.x.col(s.j[k]) - world.particles.x.col(s.i[k])).norm();
-    sum += std::max(0.0, l / s.l0[k] - 1.1);
+    const double l = (world.particles.x.col(s.j(k)) - world.particles.x.col(s.i(k))).norm();
+    sum += std::max(0.0, l / s.l0(k) - 1.1);
   }
   return sum;
 }
@@ -40,8 +40,8 @@ double max_strain(const clothlab::World& world) {
   const clothlab::SpringSet& s = test::springs_of(world);
   double worst = -1.0;
   for (size_t k = 0; k < s.size(); ++k) {
-    const double l = (world.particles.x.col(s.j[k]) - world.particles.x.col(s.i[k])).norm();
-    worst = std::max(worst, l / s.l0[k] - 1.0);
+    const double l = (world.particles.x.col(s.j(k)) - world.particles.x.col(s.i(k))).norm();
+    worst = std::max(worst, l / s.l0(k) - 1.0);
   }
   return worst;
 }

@@ -144,7 +144,7 @@ inline const clothlab::SpringSet& springs_of(const clothlab::World& world,
 inline std::set<std::pair<clothlab::Index, clothlab::Index>> ends_of(const clothlab::SpringSet& s) {
   std::set<std::pair<clothlab::Index, clothlab::Index>> ends;
   for (size_t k = 0; k < s.size(); ++k)
-    ends.insert({std::min(s.i[k], s.j[k]), std::max(s.i[k], s.j[k])});
+    ends.insert({std::min(s.i(k), s.j(k)), std::max(s.i(k), s.j(k))});
   return ends;
 }
 
