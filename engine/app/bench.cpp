@@ -14,9 +14,6 @@
 // log-log plot by a small matplotlib script written next to the CSV.
 #include "app/bench.hpp"
 
-#include <spawn.h>
-#include <sys/wait.h>
-
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -30,6 +27,7 @@
 #include <fmt/format.h>
 
 #include "app/build_info.hpp"
+#include "app/process.hpp"
 #include "clothlab/accuracy.hpp"
 #include "clothlab/euler.hpp"
 #include "clothlab/gravity.hpp"
@@ -152,19 +150,16 @@ std::string sci(double value) {
   return std::isfinite(value) ? fmt::format("{:.2e}", value) : "-";
 }
 
-// Runs `python3 script csv out`; returns its exit status (127 when python3 cannot start).
-// Debian's own python3 comes first: that is where `apt-get install python3-matplotlib` puts
-// matplotlib, whatever other python3 comes first on the PATH.
+// Runs `python3 script csv out` and prints what it printed; returns its exit status (127 when
+// python3 cannot start). Debian's own python3 comes first: that is where `apt-get install
+// python3-matplotlib` puts matplotlib, whatever other python3 comes first on the PATH.
 int run_python(const fs::path& script, const fs::path& csv, const fs::path& out) {
-  std::fflush(stdout);  // what was printed so far comes before the script's output
-  std::string a0 = fs::exists("/usr/bin/python3") ? "/usr/bin/python3" : "python3";
-  std::string a1 = script.string(), a2 = csv.string(), a3 = out.string();
-  char* argv[] = {a0.data(), a1.data(), a2.data(), a3.data(), nullptr};
-  pid_t pid = 0;
-  if (posix_spawnp(&pid, a0.c_str(), nullptr, nullptr, argv, environ) != 0) return 127;
-  int status = 0;
-  waitpid(pid, &status, 0);
-  return WIFEXITED(status) ? WEXITSTATUS(status) : 1;
+  const ProcessResult run =
+      run_process({fs::exists("/usr/bin/python3") ? "/usr/bin/python3" : "python3", script.string(),
+                   csv.string(), out.string()},
+                  600);
+  fmt::print("{}", run.output);
+  return run.timed_out || run.signal != 0 ? 1 : run.exit_code;
 }
 
 // The cheapest stable run of each target accuracy: what the study is for.

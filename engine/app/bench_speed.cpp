@@ -25,9 +25,6 @@
 // All variants but `kernel` and `implicit` compute the same physics; the naive and bare ones are
 // checked against the engine after a few steps, and the readable and fast paths agree bit for
 // bit (a test checks it).
-#include <fcntl.h>
-#include <spawn.h>
-#include <sys/wait.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -48,6 +45,8 @@
 
 #include "app/bench.hpp"
 #include "app/build_info.hpp"
+#include "app/process.hpp"
+#include "app/submission.hpp"
 #include "clothlab/cloth.hpp"
 #include "clothlab/euler.hpp"
 #include "clothlab/fast_forces.hpp"
@@ -522,13 +521,11 @@ void measure_size(int n, int all_cores, const SpeedOptions& opt, std::vector<Mea
 // Runs clothlab-student (found beside this program) on the reference variant and adds its rows
 // as "student"; returns why not, when it could not.
 std::string measure_student(const SpeedOptions& opt, std::vector<Measurement>& rows) {
-  std::error_code error;
-  const fs::path self = fs::read_symlink("/proc/self/exe", error);
-  const fs::path student = self.parent_path() / "clothlab-student";
-  if (error || !fs::exists(student)) return "clothlab-student was not found beside clothlab";
+  const fs::path student = fs::path(build_dir()) / "clothlab-student";
+  if (!fs::exists(student)) return "clothlab-student was not found beside clothlab";
   const fs::path dir = fs::temp_directory_path() / fmt::format("clothlab-bench-{}", getpid());
   fs::create_directories(dir);
-  const fs::path csv = dir / "student.csv", log = dir / "student.log";
+  const fs::path csv = dir / "student.csv";
   std::vector<std::string> args{student.string(), "bench",
                                 "speed",          "--no-student",
                                 "--variants",     "reference",
@@ -539,27 +536,11 @@ std::string measure_student(const SpeedOptions& opt, std::vector<Measurement>& r
                                 "--sizes"};
   for (int n : opt.sizes)
     args.push_back(std::to_string(n));
-  std::vector<char*> argv;
-  for (std::string& a : args)
-    argv.push_back(a.data());
-  argv.push_back(nullptr);
-  posix_spawn_file_actions_t actions;
-  posix_spawn_file_actions_init(&actions);
-  posix_spawn_file_actions_addopen(&actions, STDOUT_FILENO, log.c_str(),
-                                   O_WRONLY | O_CREAT | O_TRUNC, 0644);
-  posix_spawn_file_actions_adddup2(&actions, STDOUT_FILENO, STDERR_FILENO);
-  std::fflush(stdout);
-  pid_t pid = 0;
-  const int spawned = posix_spawn(&pid, argv[0], &actions, nullptr, argv.data(), environ);
-  posix_spawn_file_actions_destroy(&actions);
-  if (spawned != 0) return "clothlab-student could not be started";
-  int status = 0;
-  waitpid(pid, &status, 0);
-  std::ifstream log_file(log);
-  const std::string output((std::istreambuf_iterator<char>(log_file)),
-                           std::istreambuf_iterator<char>());
+  const ProcessResult run = run_process(args, 24 * 3600);
+  const std::string& output = run.output;
   std::string why;
-  if (!WIFEXITED(status) || WEXITSTATUS(status) != 0) {
+  if (run.exit_code == 127) return "clothlab-student could not be started";
+  if (run.timed_out || run.signal != 0 || run.exit_code != 0) {
     // A stub names its exercise: "exercise ex02.1 is not implemented yet: see ...".
     const size_t at = output.find("exercise ex");
     if (at != std::string::npos) {
@@ -592,6 +573,7 @@ std::string measure_student(const SpeedOptions& opt, std::vector<Measurement>& r
       rows.push_back(m);
     }
   }
+  std::error_code error;
   fs::remove_all(dir, error);
   return why;
 }

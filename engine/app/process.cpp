@@ -129,10 +129,25 @@ InterruptGuard::~InterruptGuard() {
 ProcessResult run_process(const std::vector<std::string>& args, double timeout,
                           const ProcessLimits& limits, const std::vector<std::string>& env,
                           bool events) {
-  // Built before fork(): the child may only make async-signal-safe calls.
+  // Built before fork(): the child may only make async-signal-safe calls. A program named without
+  // a folder is looked for on the PATH.
+  std::vector<std::string> program_args = args;
+  if (!program_args.empty() && program_args[0].find('/') == std::string::npos) {
+    const char* path = std::getenv("PATH");
+    std::string_view dirs = path != nullptr ? path : "/usr/bin:/bin";
+    for (std::size_t at = 0; at <= dirs.size();) {
+      const std::size_t end = std::min(dirs.find(':', at), dirs.size());
+      const std::string candidate = std::string(dirs.substr(at, end - at)) + "/" + program_args[0];
+      if (end > at && access(candidate.c_str(), X_OK) == 0) {
+        program_args[0] = candidate;
+        break;
+      }
+      at = end + 1;
+    }
+  }
   std::vector<char*> argv;
-  for (const auto& a : args)
-    argv.push_back(const_cast<char*>(a.c_str()));
+  for (auto& a : program_args)
+    argv.push_back(a.data());
   argv.push_back(nullptr);
   std::vector<std::string> env_entries = env;
   if (events) env_entries.push_back("CLOTHLAB_EVENTS_FD=" + std::to_string(kEventsFd));
@@ -150,6 +165,7 @@ ProcessResult run_process(const std::vector<std::string>& args, double timeout,
   if (pid < 0) throw std::system_error(errno, std::generic_category(), "fork");
   if (pid == 0) {
     setpgid(0, 0);  // its own process group: a timeout kills whatever the case started too
+    prctl(PR_SET_PDEATHSIG, SIGKILL);  // and it ends if this process dies (Ctrl-C, say)
     auto limit = [](int resource, rlim_t value) {
       if (value == 0) return;
       const rlimit r{value, value};

@@ -1,8 +1,9 @@
 // process.hpp: running one program with a real timeout, for the grader.
 //
-// A grading case, or the build of a student's submission, runs as a child process in its own
-// process group, with its output captured. When the time is up, or when the grader is
-// interrupted (Ctrl-C, or a TERM from an autograder), the whole group is killed, so no orphan
+// A grading case, the build of a student's submission, or a program `clothlab bench` runs (the
+// plot script, the student build), runs as a child process in its own process group, with its
+// output captured: the one way this program starts another. When the time is up, or when the grader
+// is interrupted (Ctrl-C, or a TERM from an autograder), the whole group is killed, so no orphan
 // keeps running.
 #pragma once
 
@@ -55,9 +56,9 @@ struct ProcessLimits {
   std::size_t file_bytes = 0;    // size of any file it writes (RLIMIT_FSIZE)
 };
 
-// Runs args[0] (an absolute path) with args, stdin from /dev/null, for at most timeout [s], with
-// this process's environment and `env` ("NAME=value", in place of the same names). With
-// `events`, the child also gets a pipe of its own as descriptor kEventsFd (and
+// Runs args[0] (a path, or a name looked for on the PATH) with args, stdin from /dev/null, for at
+// most timeout [s], with this process's environment and `env` ("NAME=value", in place of the same
+// names). With `events`, the child also gets a pipe of its own as descriptor kEventsFd (and
 // CLOTHLAB_EVENTS_FD=3 in its environment), read into ProcessResult::events.
 // Whatever the child started ends with it: its process group is killed when it ends, and so is
 // any process that left the group (setsid) and was handed to this one when its parent died.
