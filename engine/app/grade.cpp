@@ -10,6 +10,7 @@
 // cannot reach the pipe the verdicts go through (tests/grade/kernel_wire.hpp). A submission's
 // kernels run in a sandbox.
 #include "app/grade.hpp"
+#include "app/exit_codes.hpp"
 #include "app/process.hpp"
 #include "app/sandbox.hpp"
 #include "app/submission.hpp"
@@ -435,7 +436,7 @@ std::vector<Case> list_cases(const std::string& binary) {
       run_process({binary, "--list-test-cases", "--reporters=clothlab"}, 60, {}, {}, true);
   std::vector<Fields> events = parse_events(run.events);
   if (run.timed_out || run.signal != 0 || run.exit_code != 0) {
-    fail(2, fmt::format("listing the cases of {} failed:\n{}", binary, run.output));
+    fail(kExitBadInput, fmt::format("listing the cases of {} failed:\n{}", binary, run.output));
   }
   std::vector<Case> cases;
   for (Fields& e : events) {
@@ -462,13 +463,15 @@ std::vector<Case> list_cases(const std::string& binary) {
                                                   "after_published"};
     if (std::find(std::begin(kVisibilities), std::end(kVisibilities), c.visibility) ==
         std::end(kVisibilities)) {
-      fail(2, fmt::format("{}:{}: case \"{}\" has visibility \"{}\"; expected visible, hidden, "
-                          "after_due_date or after_published",
-                          c.file, c.line, c.name, c.visibility));
+      fail(kExitBadInput,
+           fmt::format("{}:{}: case \"{}\" has visibility \"{}\"; expected visible, hidden, "
+                       "after_due_date or after_published",
+                       c.file, c.line, c.name, c.visibility));
     }
     cases.push_back(c);
   }
-  if (cases.empty()) fail(2, binary + " lists no test cases (was it built with grade_main.cpp?)");
+  if (cases.empty())
+    fail(kExitBadInput, binary + " lists no test cases (was it built with grade_main.cpp?)");
   // doctest lists by file, and a hidden file may come first: order by exercise (ex01.2 before
   // ex01.10), keeping each exercise's cases in their order.
   auto key = [](const Case& c) {
@@ -656,12 +659,14 @@ void check_report_path(const std::string& option, const std::string& path) {
   const fs::file_status status = fs::symlink_status(path, ec);
   if (ec || !fs::exists(status)) return;
   if (fs::is_symlink(status))
-    fail(2, fmt::format("{} {}: is a symbolic link; give the path of a new or a regular file",
-                        option, path));
+    fail(kExitBadInput,
+         fmt::format("{} {}: is a symbolic link; give the path of a new or a regular file", option,
+                     path));
   if (!fs::is_regular_file(status))
-    fail(2, fmt::format("{} {}: is not a regular file (a device or a folder?); give the path of a "
-                        "new or a regular file",
-                        option, path));
+    fail(kExitBadInput,
+         fmt::format("{} {}: is not a regular file (a device or a folder?); give the path of a "
+                     "new or a regular file",
+                     option, path));
 }
 
 // Written to a new file beside `path` (created here, so no one else's file or link is
@@ -670,10 +675,10 @@ void write_file(const std::string& path, const std::string& text) {
   std::error_code ec;
   const fs::file_status status = fs::symlink_status(path, ec);
   if (!ec && fs::exists(status) && !fs::is_regular_file(status))
-    fail(2, "not writing " + path + ": it is no longer a regular file");
+    fail(kExitBadInput, "not writing " + path + ": it is no longer a regular file");
   const std::string tmp = fmt::format("{}.{}.tmp", path, getpid());
   const int fd = open(tmp.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_NOFOLLOW | O_CLOEXEC, 0644);
-  if (fd < 0) fail(2, "cannot write " + tmp + ": " + std::strerror(errno));
+  if (fd < 0) fail(kExitBadInput, "cannot write " + tmp + ": " + std::strerror(errno));
   std::size_t written = 0;
   while (written < text.size()) {
     const ssize_t n = write(fd, text.data() + written, text.size() - written);
@@ -681,7 +686,7 @@ void write_file(const std::string& path, const std::string& text) {
     if (n <= 0) {
       close(fd);
       fs::remove(tmp, ec);
-      fail(2, "cannot write " + tmp + ": " + std::strerror(errno));
+      fail(kExitBadInput, "cannot write " + tmp + ": " + std::strerror(errno));
     }
     written += static_cast<std::size_t>(n);
   }
@@ -689,7 +694,7 @@ void write_file(const std::string& path, const std::string& text) {
   fs::rename(tmp, path, ec);
   if (ec) {
     fs::remove(tmp, ec);
-    fail(2, "cannot write " + path + ": " + ec.message());
+    fail(kExitBadInput, "cannot write " + path + ": " + ec.message());
   }
 }
 
@@ -845,8 +850,9 @@ std::string classroom_workflow(const std::vector<Case>& cases) {
 std::string built_program(const std::string& name) {
   const fs::path path = fs::path(build_dir()) / name;
   if (!fs::exists(path)) {
-    fail(2, fmt::format("{} does not exist: build it first with\n  cmake --build build --target {}",
-                        path.string(), name));
+    fail(kExitBadInput,
+         fmt::format("{} does not exist: build it first with\n  cmake --build build --target {}",
+                     path.string(), name));
   }
   return path.string();
 }
@@ -931,7 +937,7 @@ std::string build_own(const Options& o, std::vector<Case>& cases, std::string& n
     build =
         build_submission(dir, o.scratch.empty() ? own_scratch() : o.scratch, o.build_timeout, true);
   } catch (const std::exception& e) {
-    fail(2, e.what());
+    fail(kExitBadInput, e.what());
   }
   if (colour) fmt::print("\r\033[K");
   hold = build.hold;  // the scratch folder stays this grader's while the binary is graded
@@ -969,15 +975,15 @@ void grade(const Options& o) {
   if ((submission || own) &&
       (grading || !fs::exists(fs::path(grade_kit_dir()).parent_path() / "grade-cases"))) {
     const std::string why = update_grade_kit(o.build_timeout);
-    if (!why.empty()) fail(2, why);
+    if (!why.empty()) fail(kExitBadInput, why);
   }
   if (o.impl == "reference" && !CLOTHLAB_HAVE_SOLUTIONS && !submission && o.binary.empty())
-    fail(2, "this is a student release: it has no reference solutions to grade");
+    fail(kExitBadInput, "this is a student release: it has no reference solutions to grade");
   // The grading binary, and the kernels it calls: those of --impl, or those the kit builds below
   // from a submission or the student's exercises. (--binary: a binary with code of its own.)
   Grader grader;
   grader.binary = o.binary.empty() ? built_program("grade-cases") : o.binary;
-  if (!fs::exists(grader.binary)) fail(2, grader.binary + " does not exist");
+  if (!fs::exists(grader.binary)) fail(kExitBadInput, grader.binary + " does not exist");
   if (!submission && !own && o.binary.empty())
     grader.kernels = built_program("grade-kernels-" + o.impl);
   std::vector<Case> cases = list_cases(grader.binary);
@@ -986,7 +992,7 @@ void grade(const Options& o) {
   if (!o.hidden) std::erase_if(cases, [](const Case& c) { return c.hidden_test; });
   if (!o.exercise.empty()) {
     std::erase_if(cases, [&](const Case& c) { return !selected(c, o.exercise); });
-    if (cases.empty()) fail(2, "no grading case belongs to exercise " + o.exercise);
+    if (cases.empty()) fail(kExitBadInput, "no grading case belongs to exercise " + o.exercise);
   }
   if (o.list) {
     print_points_table(cases);
@@ -1019,7 +1025,8 @@ void grade(const Options& o) {
     std::cout << std::flush;
     if (!warnings.empty()) std::cerr << "clothlab grade: warning: " << warnings;
     if (confinement.bwrap.empty() && o.sandbox == "on")
-      fail(2, "--sandbox on: bubblewrap (bwrap) is not installed or cannot make namespaces here");
+      fail(kExitBadInput,
+           "--sandbox on: bubblewrap (bwrap) is not installed or cannot make namespaces here");
     if (confinement.bwrap.empty()) {
       std::cerr << "clothlab grade: WARNING: no sandbox (bubblewrap is not installed, or cannot "
                    "make namespaces here): the submission's code runs as "
@@ -1039,7 +1046,7 @@ void grade(const Options& o) {
       build = build_submission(o.submission, o.scratch.empty() ? default_scratch() : o.scratch,
                                o.build_timeout, false, o.sandbox != "off" ? &confinement : nullptr);
     } catch (const std::exception& e) {
-      fail(2, e.what());
+      fail(kExitBadInput, e.what());
     }
     if (colour) fmt::print("\r\033[K");
     hold = build.hold;
@@ -1073,14 +1080,16 @@ void grade(const Options& o) {
 
   fmt::print("{}", summary(cases, colour));
   write_reports(o, cases, elapsed(), notes);
-  if (g_interrupted) fail(130, "interrupted: the results of the cases run so far are written");
+  if (g_interrupted)
+    fail(kExitInterrupted, "interrupted: the results of the cases run so far are written");
   if (o.autolab) fmt::print("{}\n", autolab_line(cases));
 
   if (o.require_full) {
     const auto failed =
         std::count_if(cases.begin(), cases.end(), [](const Case& c) { return !c.passed; });
     if (failed > 0)
-      fail(1, fmt::format("--require-full: {} of {} cases did not pass", failed, cases.size()));
+      fail(kExitFailed,
+           fmt::format("--require-full: {} of {} cases did not pass", failed, cases.size()));
   }
   if (o.require_zero) {
     std::string scored;
@@ -1089,7 +1098,8 @@ void grade(const Options& o) {
         scored += fmt::format("\n  {} scores {} / {} points", x.id, x.earned, x.max);
     }
     if (!scored.empty()) {
-      fail(1, "--require-zero: these exercises score points, so their tests cannot fail:" + scored);
+      fail(kExitFailed,
+           "--require-zero: these exercises score points, so their tests cannot fail:" + scored);
     }
   }
 }
@@ -1123,7 +1133,7 @@ void watch(Options o) {
     try {
       grade(o);
     } catch (const CLI::RuntimeError& e) {
-      if (e.get_exit_code() == 130) throw;  // interrupted while grading
+      if (e.get_exit_code() == kExitInterrupted) throw;  // interrupted while grading
       // Anything else the grader could not do is said; the next save may mend it.
     }
     if (o.rounds > 0 && round >= o.rounds) return;

@@ -14,8 +14,9 @@ class App;
 namespace clothlab::app {
 
 // Adds the `grade` subcommand to app. On failure its callback throws CLI::RuntimeError with the
-// exit status (1: --require-full or --require-zero not met, 2: the grader could not run,
-// 130: interrupted), which CLI11_PARSE / app.exit() turn into main's return value.
+// exit status (exit_codes.hpp: kExitFailed when --require-full or --require-zero is not met,
+// kExitBadInput when the grader cannot run, kExitInterrupted), which CLI11_PARSE / app.exit()
+// turn into main's return value.
 void add_grade_command(CLI::App& app);
 
 // Adds `watch [exNN[.k]]`: grades the student's exercises, then again on every save.

@@ -25,6 +25,7 @@
 #include "app/bench.hpp"
 #include "app/build_info.hpp"
 #include "app/demo_scene.hpp"
+#include "app/exit_codes.hpp"
 #include "app/grade.hpp"
 #include "clothlab/implicit_euler.hpp"
 #include "clothlab/not_implemented.hpp"
@@ -36,11 +37,6 @@ namespace fs = std::filesystem;
 using namespace clothlab;
 
 namespace {
-
-// Exit codes a script can tell apart.
-constexpr int kBadScene = 2;  // the scene file is wrong; nothing was written
-constexpr int kBlewUp = 3;    // the simulation stopped; frames up to then were written
-constexpr int kNotDone = 4;   // an exercise kernel is still a stub
 
 // A progress bar on stderr, only when stderr is a terminal and the run lasts a moment: half a
 // second, or the seconds in the environment variable CLOTHLAB_PROGRESS_AFTER (the tests set 0,
@@ -163,7 +159,7 @@ int run(Scene& scene, const RunOutputs& outputs, bool stats) {
     fmt::print(stderr, "error: {}\n", error.what());
     fmt::print(stderr, "  frames up to step {} are in {}/{}\n", error.step() - 1, out_dir.string(),
                outputs.html.empty() ? "" : fmt::format(" and {}", outputs.html.string()));
-    return kBlewUp;
+    return app::kExitBlewUp;
   }
 }
 
@@ -255,14 +251,14 @@ int main(int argc, char** argv) {
   } catch (const SceneError& error) {
     std::fflush(stdout);
     fmt::print(stderr, "error: {}\n", error.what());
-    return kBadScene;
+    return app::kExitBadInput;
   } catch (const NotImplemented& error) {
     std::fflush(stdout);
     fmt::print(stderr, "error: {}\n", error.what());
-    return kNotDone;
+    return app::kExitNotDone;
   } catch (const std::exception& error) {
     fmt::print(stderr, "error: {}\n", error.what());
-    return 1;
+    return app::kExitFailed;
   }
   return 0;
 }
