@@ -13,7 +13,7 @@
 
 namespace clothlab {
 
-// Exercise 3.1: the aerodynamic force on one triangle.
+// Exercise ex03.1: the aerodynamic force on one triangle.
 //   v = (v1 + v2 + v3) / 3 - v_air,   n* = (r2 - r1) x (r3 - r1)
 //   f_aero = -1/2 rho cd (|v| (v . n*) / (2 |n*|)) n*
 // Hints:
@@ -29,7 +29,7 @@ Vec3 aerodynamic_force(const Vec3& r1, const Vec3& r2, const Vec3& r3, const Vec
   // END ex03.1
 }
 
-// Exercise 3.2: fluid drag on one particle, f = -1/2 rho |u|^2 cd a e with u = v - v_air.
+// Exercise ex03.2: fluid drag on one particle, f = -1/2 rho |u|^2 cd a e with u = v - v_air.
 // Hints:
 //   1. e = u / |u| points along the relative velocity; the force points the other way.
 //   2. |u|^2 e = |u| u: no division needed, and u = 0 gives zero by itself.

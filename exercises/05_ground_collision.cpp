@@ -13,7 +13,7 @@
 
 namespace clothlab {
 
-// Exercise 5.1: the response of a particle found `depth` inside a solid with outward normal n.
+// Exercise ex05.1: the response of a particle found `depth` inside a solid with outward normal n.
 //   r' = r + depth n                                   (back onto the surface)
 //   v_n = (v . n) n,  v_t = v - v_n
 //   if v . n < 0:  j = (1 + e) |v . n|,  v_n' = -e v_n  (bounce)

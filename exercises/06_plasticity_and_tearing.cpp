@@ -17,7 +17,7 @@
 
 namespace clothlab {
 
-// Exercise 6.1: the plastic update of one spring's rest length (see plasticity.hpp).
+// Exercise ex06.1: the plastic update of one spring's rest length (see plasticity.hpp).
 //   strain = (l - l0) / l0; within +-yield_strain nothing changes;
 //   otherwise target = l / (1 + yield_strain) (stretched) or l / (1 - yield_strain) (compressed),
 //   l0' = l0 + min(1, flow_rate dt) (target - l0), kept within l_built (1 +- max_strain).
@@ -33,7 +33,7 @@ double plastic_rest_length(double l, double l0, double l_built, const PlasticLim
   // END ex06.1
 }
 
-// Exercise 6.2: which springs tear this step (see tearing.hpp).
+// Exercise ex06.2: which springs tear this step (see tearing.hpp).
 // Hints:
 //   1. Collect the positions k with strain[k] > tear_strain.
 //   2. If max_tears > 0 and there are more than that, sort them most strained first, equal

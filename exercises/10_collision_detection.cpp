@@ -17,7 +17,7 @@
 
 namespace clothlab {
 
-// Exercise 10.1: the cell of edge h that holds x (see spatial_hash.hpp).
+// Exercise ex10.1: the cell of edge h that holds x (see spatial_hash.hpp).
 //   ix = floor(x / h),  iy = floor(y / h),  iz = floor(z / h)
 // Hints:
 //   1. std::floor, then a cast to std::int64_t. A cast alone truncates toward zero: -0.4 would
@@ -29,7 +29,7 @@ Cell cell_of(const Vec3& x, double h) {
   // END ex10.1
 }
 
-// Exercise 10.1: the slot of cell c in a table of table_size slots.
+// Exercise ex10.1: the slot of cell c in a table of table_size slots.
 //   hash = (ix * 73856093  xor  iy * 19349663  xor  iz * 83492791)  mod  table_size
 // Hints:
 //   3. Compute on std::uint64_t: cast each coordinate first (static_cast<std::uint64_t>(c.ix)),
@@ -43,7 +43,7 @@ std::size_t cell_hash(const Cell& c, std::size_t table_size) {
   // END ex10.1
 }
 
-// Exercise 10.2: the response of one pair of particles closer than the thickness (see
+// Exercise ex10.2: the response of one pair of particles closer than the thickness (see
 // self_collision.hpp). With d* = r2 - r1, d = |d*|, n = d* / d, w = w1 + w2:
 //   C = thickness - d;  r1' = r1 - (w1 / w) C n,  r2' = r2 + (w2 / w) C n
 //   u = v2 - v1;  if u . n < 0 (approaching):

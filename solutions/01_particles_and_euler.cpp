@@ -15,7 +15,7 @@
 
 namespace clothlab {
 
-// Exercise 1.1: uniform gravity, f = m g.
+// Exercise ex01.1: uniform gravity, f = m g.
 // Hints:
 //   1. m is a mass [kg] and g an acceleration [m/s^2]: their product is a force [N].
 //   2. One line. Eigen lets you multiply a scalar by a Vec3 directly.
@@ -25,7 +25,7 @@ Vec3 gravity_force(double m, const Vec3& g) {
   // END ex01.1
 }
 
-// Exercise 1.2: Newton's gravitation, F = G m1 m2 / r^2, on body 1 toward body 2.
+// Exercise ex01.2: Newton's gravitation, F = G m1 m2 / r^2, on body 1 toward body 2.
 // Hints:
 //   1. d = r2 - r1 points from body 1 to body 2; r = |d| is their distance.
 //   2. The force on body 1 points along d / r (toward body 2) with magnitude G m1 m2 / r^2.
@@ -40,7 +40,7 @@ Vec3 gravitation_force(const Vec3& r1, double m1, const Vec3& r2, double m2, dou
   // END ex01.2
 }
 
-// Exercise 1.3: explicit (forward) Euler. Everything on the right uses the OLD state:
+// Exercise ex01.3: explicit (forward) Euler. Everything on the right uses the OLD state:
 //   a = f / m,   v' = v + a dt,   r' = r + v dt.
 // Hints:
 //   1. You are given inv_m = 1/m, so a = f * inv_m (a pinned particle has inv_m = 0).
@@ -53,7 +53,7 @@ PointState explicit_euler_step(const Vec3& r, const Vec3& v, const Vec3& f, doub
   // END ex01.3
 }
 
-// Exercise 1.4: the lecture's Euler, semi-implicit (symplectic):
+// Exercise ex01.4: the lecture's Euler, semi-implicit (symplectic):
 //   a = f / m,   v' = v + a dt,   r' = r + v' dt.
 // Hints:
 //   1. Same as 1.3 except for one symbol: the position moves with the NEW velocity v'.

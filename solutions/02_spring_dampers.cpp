@@ -13,7 +13,7 @@
 
 namespace clothlab {
 
-// Exercise 2.1: the spring-damper force on particle 1.
+// Exercise ex02.1: the spring-damper force on particle 1.
 //   e* = r2 - r1,  l = |e*|,  e = e* / l
 //   v1 = e . v1,   v2 = e . v2
 //   f_sd = -ks (l0 - l) - kd (v1 - v2),   f1 = f_sd e
@@ -38,7 +38,7 @@ Vec3 spring_damper_force(const Vec3& r1, const Vec3& r2, const Vec3& v1, const V
   // END ex02.1
 }
 
-// Exercise 2.2: the energy stored in the spring, U = 1/2 ks (l - l0)^2.
+// Exercise ex02.2: the energy stored in the spring, U = 1/2 ks (l - l0)^2.
 // Hints:
 //   1. l = |r2 - r1|. The damper stores no energy: kd does not appear.
 //   2. The spring force is minus the slope of this energy: the grader checks the two agree.

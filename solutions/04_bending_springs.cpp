@@ -13,7 +13,7 @@
 
 namespace clothlab {
 
-// Exercise 4.1: the bending pairs of a rows x cols grid, as grid-local indices r * cols + c:
+// Exercise ex04.1: the bending pairs of a rows x cols grid, as grid-local indices r * cols + c:
 // (r,c)-(r,c+2) along every row and (r,c)-(r+2,c) down every column.
 // Hints:
 //   1. Look at structural_pairs() in engine/clothlab/cloth.cpp: the same loops, two apart.

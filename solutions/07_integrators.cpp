@@ -13,7 +13,7 @@
 
 namespace clothlab {
 
-// Exercise 7.1: the midpoint method (RK2). Take half a step with Euler, measure the
+// Exercise ex07.1: the midpoint method (RK2). Take half a step with Euler, measure the
 // acceleration there, and use that midpoint's rates for the whole step:
 //   a1 = a(x, v)
 //   x2 = x + dt/2 v,   v2 = v + dt/2 a1,   a2 = a(x2, v2)
@@ -36,7 +36,7 @@ void midpoint_step(Matrix3X& x, Matrix3X& v, double dt, const AccelerationField&
   // END ex07.1
 }
 
-// Exercise 7.2: classical Runge-Kutta (RK4). Four stages, each a trial step from the START of
+// Exercise ex07.2: classical Runge-Kutta (RK4). Four stages, each a trial step from the START of
 // the step using the rates found by the stage before, then a weighted average (1, 2, 2, 1)/6:
 //   stage 1: x1 = x,            v1 = v,            a1 = a(x1, v1)
 //   stage 2: x2 = x + dt/2 v1,  v2 = v + dt/2 a1,  a2 = a(x2, v2)

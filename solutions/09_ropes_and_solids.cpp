@@ -15,7 +15,7 @@
 
 namespace clothlab {
 
-// Exercise 9.1: one strain-limiting correction (Provot's deformation constraint) for one spring
+// Exercise ex09.1: one strain-limiting correction (Provot's deformation constraint) for one spring
 // (see strain_limiting.hpp).
 //   e* = r2 - r1,  l = |e*|,  e = e* / l
 //   target = (1 + max_strain) l0 if l is longer, (1 - max_compression) l0 if l is shorter;

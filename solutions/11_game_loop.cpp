@@ -16,7 +16,7 @@
 
 namespace clothlab {
 
-// Exercise 11.1: the accumulator's arithmetic for one frame (see game_loop.hpp).
+// Exercise ex11.1: the accumulator's arithmetic for one frame (see game_loop.hpp).
 //   time = leftover + frame_time                  what the accumulator holds [s]
 //   n    = floor(time / dt + kStepTolerance)      whole steps due; a time a hair short of a
 //                                                 step counts as the step

@@ -241,7 +241,7 @@ std::string number_of(const std::string& exercise) {
   return std::to_string(std::stoi(exercise.substr(2, dot - 2))) + part;
 }
 
-// "see lessons/01-particles-and-euler/README.md, Exercise 1.3"
+// "see lessons/01-particles-and-euler/README.md, Exercise ex01.3"
 std::string lesson_hint(const std::string& exercise) {
   if (!is_exercise_id(exercise, true)) return "";
   const std::string prefix = exercise.substr(2, exercise.find('.') - 2) + "-";  // "01-"
@@ -253,7 +253,7 @@ std::string lesson_hint(const std::string& exercise) {
       lesson = "lessons/" + folder + "/README.md";
     }
   }
-  return "see " + lesson + ", Exercise " + number_of(exercise);
+  return "see " + lesson + ", Exercise " + exercise;
 }
 
 std::string relative_path(const std::string& file) {

@@ -26,13 +26,13 @@ namespace clothlab {
 
 inline constexpr double kAirDensity = 1.225;  // rho of air at sea level, 15 C [kg/m^3]
 
-// Exercise 3.1: the total aerodynamic force [N] on the triangle (r1, r2, r3) [m] whose corners
+// Exercise ex03.1: the total aerodynamic force [N] on the triangle (r1, r2, r3) [m] whose corners
 // move at v1, v2, v3 [m/s], in air of density rho [kg/m^3] moving at v_air [m/s], with drag
 // coefficient cd. Zero (never NaN) for a zero-area triangle or zero relative velocity.
 Vec3 aerodynamic_force(const Vec3& r1, const Vec3& r2, const Vec3& r3, const Vec3& v1,
                        const Vec3& v2, const Vec3& v3, const Vec3& v_air, double rho, double cd);
 
-// Exercise 3.2: fluid drag on one particle (game-physics lecture), f = -1/2 rho |u|^2 cd a e,
+// Exercise ex03.2: fluid drag on one particle (game-physics lecture), f = -1/2 rho |u|^2 cd a e,
 // where u = v - v_air is the velocity relative to the fluid and e = u / |u| its direction;
 // a [m^2] is the particle's cross-sectional area. Zero when u = 0.
 Vec3 fluid_drag_force(const Vec3& v, const Vec3& v_air, double rho, double cd, double a);

@@ -44,7 +44,7 @@ ClothGrid add_cloth(Particles& p, const ClothSpec& spec);
 std::vector<IndexPair> structural_pairs(Index rows, Index cols);  // (r,c)-(r,c+1), (r,c)-(r+1,c)
 std::vector<IndexPair> shear_pairs(Index rows, Index cols);  // (r,c)-(r+1,c+1), (r,c+1)-(r+1,c)
 
-// Exercise 4.1: the bending (flexion) pairs of a rows x cols grid, particles two apart along
+// Exercise ex04.1: the bending (flexion) pairs of a rows x cols grid, particles two apart along
 // rows and along columns: (r,c)-(r,c+2) and (r,c)-(r+2,c), as grid-local indices r * cols + c.
 std::vector<IndexPair> bending_pairs(Index rows, Index cols);
 

@@ -23,12 +23,12 @@ struct PointState {
   Vec3 v;
 };
 
-// Exercise 1.3: one explicit Euler step of dt [s] for a particle at r [m] with velocity
+// Exercise ex01.3: one explicit Euler step of dt [s] for a particle at r [m] with velocity
 // v [m/s], total force f [N] and inverse mass inv_m [1/kg].
 PointState explicit_euler_step(const Vec3& r, const Vec3& v, const Vec3& f, double inv_m,
                                double dt);
 
-// Exercise 1.4: the same step with the lecture's semi-implicit (symplectic) Euler.
+// Exercise ex01.4: the same step with the lecture's semi-implicit (symplectic) Euler.
 PointState symplectic_euler_step(const Vec3& r, const Vec3& v, const Vec3& f, double inv_m,
                                  double dt);
 

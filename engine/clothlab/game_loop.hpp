@@ -51,7 +51,7 @@ struct Substeps {
   double dropped = 0.0;   // time given up because the steps due exceeded the cap [s]
 };
 
-// Exercise 11.1: the accumulator's arithmetic for one frame. `leftover` [s] is what the last
+// Exercise ex11.1: the accumulator's arithmetic for one frame. `leftover` [s] is what the last
 // frame left, `frame_time` [s] this frame's time (both >= 0), `dt` [s] the step and
 // `max_substeps` (>= 1) the cap. The steps due are the whole steps of dt in leftover +
 // frame_time, a time within kStepTolerance * dt short of a step counting as that step; at most

@@ -11,7 +11,7 @@ namespace clothlab {
 
 inline constexpr double kGravitationalConstant = 6.673e-11;  // G [N m^2 / kg^2]
 
-// Exercise 1.2: the gravitational force [N] that body 2 (at r2 [m], mass m2 [kg]) exerts on
+// Exercise ex01.2: the gravitational force [N] that body 2 (at r2 [m], mass m2 [kg]) exerts on
 // body 1 (at r1, mass m1), with gravitational constant G [N m^2/kg^2]. Coincident bodies
 // (r1 == r2) have no direction to attract along: the force is zero, never NaN.
 Vec3 gravitation_force(const Vec3& r1, double m1, const Vec3& r2, double m2, double G);

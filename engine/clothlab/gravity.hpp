@@ -8,7 +8,7 @@
 
 namespace clothlab {
 
-// Exercise 1.1: the force [N] uniform gravity g [m/s^2] exerts on a particle of mass m [kg].
+// Exercise ex01.1: the force [N] uniform gravity g [m/s^2] exerts on a particle of mass m [kg].
 // Defined in exercises/01_particles_and_euler.cpp (yours) and solutions/ (the reference).
 Vec3 gravity_force(double m, const Vec3& g);
 

@@ -22,7 +22,7 @@
 
 namespace clothlab {
 
-// Exercise 5.1: the response of a particle at r [m] with velocity v [m/s], found `depth` [m]
+// Exercise ex05.1: the response of a particle at r [m] with velocity v [m/s], found `depth` [m]
 // inside a solid whose outward unit normal at the contact is n: the particle is moved out by
 // depth along n, and its velocity is changed as above with restitution e and friction
 // coefficients mu_s (static) and mu_d (dynamic).

@@ -26,7 +26,7 @@ struct PlasticLimits {
   double max_strain = 0.5;    // largest permanent change of l0, 0 to 1 (0.5: 50 %)
 };
 
-// Exercise 6.1: the new rest length [m] of a spring of current length l [m], rest length l0 [m]
+// Exercise ex06.1: the new rest length [m] of a spring of current length l [m], rest length l0 [m]
 // and built length l_built [m], after a step of dt [s].
 double plastic_rest_length(double l, double l0, double l_built, const PlasticLimits& limits,
                            double dt);

@@ -43,13 +43,13 @@ struct RungeKuttaStages {
   void resize(Index n);
 };
 
-// Exercise 7.1: one midpoint (RK2) step of dt [s]: advances x [m] and v [m/s] in place, calling
+// Exercise ex07.1: one midpoint (RK2) step of dt [s]: advances x [m] and v [m/s] in place, calling
 // accel exactly twice. `stages` has been resized to x.cols(); use its matrices for the trial
 // state and the accelerations.
 void midpoint_step(Matrix3X& x, Matrix3X& v, double dt, const AccelerationField& accel,
                    RungeKuttaStages& stages);
 
-// Exercise 7.2: one classical Runge-Kutta (RK4) step of dt [s], calling accel exactly four
+// Exercise ex07.2: one classical Runge-Kutta (RK4) step of dt [s], calling accel exactly four
 // times, with the same conventions.
 void rk4_step(Matrix3X& x, Matrix3X& v, double dt, const AccelerationField& accel,
               RungeKuttaStages& stages);

@@ -52,7 +52,7 @@ struct PairState {
   Vec3 r2 = Vec3::Zero(), v2 = Vec3::Zero();  // particle 2
 };
 
-// Exercise 10.2: the response of one pair with inverse masses w1, w2 [1/kg], as above. A pair at
+// Exercise ex10.2: the response of one pair with inverse masses w1, w2 [1/kg], as above. A pair at
 // least `thickness` apart, a pair of two pinned particles (w1 + w2 = 0) and a pair at the same
 // point (no direction n) come back unchanged.
 PairState pair_response(const PairState& in, double w1, double w2, const SelfContact& contact);

@@ -40,11 +40,11 @@ struct Cell {
   std::int64_t ix = 0, iy = 0, iz = 0;
 };
 
-// Exercise 10.1: the cell of edge h [m] that holds the point x [m], floor(x / h) per coordinate.
+// Exercise ex10.1: the cell of edge h [m] that holds the point x [m], floor(x / h) per coordinate.
 // A point on a cell's lower face belongs to that cell: x = 0.5, h = 0.25 is in cell 2.
 Cell cell_of(const Vec3& x, double h);
 
-// Exercise 10.1: the slot of cell c in a table of table_size > 0 slots, by the hash above. The
+// Exercise ex10.1: the slot of cell c in a table of table_size > 0 slots, by the hash above. The
 // products and the xor are taken on 64-bit unsigned integers, which wrap around (a negative
 // coordinate is taken as its two's-complement bit pattern), so the result is always in
 // [0, table_size).

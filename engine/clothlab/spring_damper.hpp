@@ -39,14 +39,14 @@ struct SpringJacobian {
 SpringJacobian spring_damper_jacobian(const Vec3& r1, const Vec3& r2, double ks, double kd,
                                       double l0);
 
-// Exercise 2.1: the force [N] a spring-damper exerts on particle 1 (the force on particle 2 is
+// Exercise ex02.1: the force [N] a spring-damper exerts on particle 1 (the force on particle 2 is
 // its negative), for positions r1, r2 [m], velocities v1, v2 [m/s], spring constant ks [N/m],
 // damping factor kd [N s/m] and rest length l0 [m]. Coincident particles (l = 0) have no
 // direction to push along: the force is zero, never NaN.
 Vec3 spring_damper_force(const Vec3& r1, const Vec3& r2, const Vec3& v1, const Vec3& v2, double ks,
                          double kd, double l0);
 
-// Exercise 2.2: the energy [J] stored in the spring (not the damper), 1/2 ks (l - l0)^2.
+// Exercise ex02.2: the energy [J] stored in the spring (not the damper), 1/2 ks (l - l0)^2.
 double spring_energy(const Vec3& r1, const Vec3& r2, double ks, double l0);
 
 // A family of springs as parallel arrays: spring k joins particles i(k) and j(k), with spring

@@ -42,7 +42,7 @@ struct StrainCorrection {
   Vec3 dr2 = Vec3::Zero();
 };
 
-// Exercise 9.1: the correction of one spring from r1 to r2 [m] with rest length l0 [m] whose
+// Exercise ex09.1: the correction of one spring from r1 to r2 [m] with rest length l0 [m] whose
 // ends have inverse masses w1, w2 [1/kg] (0: pinned). Within its limits, or when it cannot be
 // corrected (both ends pinned, or coincident ends that give no direction), both moves are zero.
 StrainCorrection strain_limit_correction(const Vec3& r1, const Vec3& r2, double w1, double w2,

@@ -15,7 +15,7 @@
 
 namespace clothlab {
 
-// Exercise 6.2: the positions (ascending) of the springs that tear this step. A spring tears
+// Exercise ex06.2: the positions (ascending) of the springs that tear this step. A spring tears
 // when its strain (l / l0 - 1) is larger than tear_strain. When max_tears > 0 and more springs
 // than that are over the limit, only the max_tears most strained tear; among equal strains the
 // spring whose end particles (smaller index first) come first in lexicographic order goes first.

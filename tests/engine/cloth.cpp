@@ -57,7 +57,7 @@ void kick(clothlab::World& world) {
   }
 }
 
-// Exercise 2.1 exactly as lesson 02 writes it: e = e* / l, the two velocities along e, f_sd e.
+// Exercise ex02.1 exactly as lesson 02 writes it: e = e* / l, the two velocities along e, f_sd e.
 Vec3 lecture_spring_damper_force(const Vec3& r1, const Vec3& r2, const Vec3& v1, const Vec3& v2,
                                  double ks, double kd, double l0) {
   const Vec3 e_star = r2 - r1;

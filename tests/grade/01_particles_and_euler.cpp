@@ -36,7 +36,7 @@ PointState fall_for_one_second(EulerStep step) {
 }  // namespace
 
 TEST_SUITE("ex01") {
-  // --- Exercise 1.1: uniform gravity --------------------------------------------------------
+  // --- Exercise ex01.1: uniform gravity --------------------------------------------------------
 
   TEST_CASE("ex01.1 gravity on a 2 kg particle is m g" * POINTS(1)) {
     // f = m g = 2 kg * (0, -9.8, 0) m/s^2 = (0, -19.6, 0) N.
@@ -58,7 +58,7 @@ TEST_SUITE("ex01") {
     CHECK_NEAR_VEC(none, Vec3::Zero(), 0.0);
   }
 
-  // --- Exercise 1.2: Newton's gravitation ---------------------------------------------------
+  // --- Exercise ex01.2: Newton's gravitation ---------------------------------------------------
 
   TEST_CASE("ex01.2 two 1 kg bodies 1 m apart with G = 1 pull with 1 N" * POINTS(1)) {
     // F = G m1 m2 / r^2 = 1 * 1 * 1 / 1^2 = 1 N, on body 1 toward body 2 (+x).
@@ -110,7 +110,7 @@ TEST_SUITE("ex01") {
     }
   }
 
-  // --- Exercise 1.3: explicit Euler ---------------------------------------------------------
+  // --- Exercise ex01.3: explicit Euler ---------------------------------------------------------
 
   TEST_CASE("ex01.3 one explicit Euler step worked by hand" * POINTS(1)) {
     // r = (1, 2, 3), v = (4, 5, 6), f = (2, 0, -4), 1/m = 0.5, dt = 0.1:
@@ -153,7 +153,7 @@ TEST_SUITE("ex01") {
     CHECK(v.y() == doctest::Approx(-9.8).epsilon(1e-9));
   }
 
-  // --- Exercise 1.4: symplectic Euler -------------------------------------------------------
+  // --- Exercise ex01.4: symplectic Euler -------------------------------------------------------
 
   TEST_CASE("ex01.4 one symplectic Euler step worked by hand" * POINTS(1)) {
     // Same inputs as ex01.3: a = (1, 0, -2), v' = (4.1, 5, 5.8), and now

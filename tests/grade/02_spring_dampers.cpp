@@ -63,7 +63,7 @@ Vec3 central_gradient(const Energy& energy, const Vec3& r, double h) {
 }  // namespace
 
 TEST_SUITE("ex02") {
-  // --- Exercise 2.1: the spring-damper force --------------------------------------------------
+  // --- Exercise ex02.1: the spring-damper force --------------------------------------------------
 
   TEST_CASE("ex02.1 a stretched spring pulls and a compressed one pushes" * POINTS(1)) {
     // r1 = (1, 2, 3), r2 = r1 + (2, -3, 6): e* = (2, -3, 6), l = sqrt(4 + 9 + 36) = 7,
@@ -224,7 +224,7 @@ TEST_SUITE("ex02") {
     CHECK_NEAR_VEC(f1, Vec3::Zero(), 0.0);
   }
 
-  // --- Exercise 2.2: the energy of a spring ---------------------------------------------------
+  // --- Exercise ex02.2: the energy of a spring ---------------------------------------------------
 
   TEST_CASE("ex02.2 the energy of a stretched spring worked by hand" * POINTS(1)) {
     // r2 - r1 = (2, -3, 6), l = 7. ks = 14 N/m, l0 = 5 m: U = 1/2 * 14 * (7 - 5)^2 = 28 J.

@@ -54,7 +54,7 @@ Vec3 force_on(const AeroCase& t) {
 }  // namespace
 
 TEST_SUITE("ex03") {
-  // --- Exercise 3.1: the aerodynamic force on a triangle -------------------------------------
+  // --- Exercise ex03.1: the aerodynamic force on a triangle -------------------------------------
 
   TEST_CASE("ex03.1 air hitting a right triangle head on pushes with 30 N" * POINTS(1)) {
     // Right triangle with legs of 1 m in the x-y plane: r1 = 0, r2 = (1, 0, 0), r3 = (0, 1, 0).
@@ -257,7 +257,7 @@ TEST_SUITE("ex03") {
     }
   }
 
-  // --- Exercise 3.2: fluid drag on a particle ------------------------------------------------
+  // --- Exercise ex03.2: fluid drag on a particle ------------------------------------------------
 
   TEST_CASE("ex03.2 drag on a particle worked by hand" * POINTS(2)) {
     // rho = 1.2 kg/m^3, cd = 0.5, a = 0.1 m^2.

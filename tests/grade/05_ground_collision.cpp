@@ -49,7 +49,7 @@ std::string describe(const Contact& c) {
 }  // namespace
 
 TEST_SUITE("ex05") {
-  // --- Exercise 5.1: the collision response ----------------------------------------------------
+  // --- Exercise ex05.1: the collision response -------------------------------------------------
 
   TEST_CASE("ex05.1 a particle below the ground comes back up and bounces at half speed" *
             POINTS(1)) {

@@ -60,7 +60,7 @@ struct TearSpring {
 }  // namespace
 
 TEST_SUITE("ex06") {
-  // --- Exercise 6.1: the plastic rest length --------------------------------------------------
+  // --- Exercise ex06.1: the plastic rest length --------------------------------------------------
 
   TEST_CASE("ex06.1 an elastic spring keeps its rest length exactly" * POINTS(1)) {
     // yield_strain = 0.25 and l0 = 2, all numbers exact in binary. A fast flow (flow_rate dt =
@@ -250,7 +250,7 @@ TEST_SUITE("ex06") {
     }
   }
 
-  // --- Exercise 6.2: choosing the springs that tear -------------------------------------------
+  // --- Exercise ex06.2: choosing the springs that tear -------------------------------------------
 
   TEST_CASE("ex06.2 only springs strictly over the limit tear" * POINTS(1)) {
     // tear_strain = 0.5, no limit on the count (max_tears = 0). Strains: 0.1 (no), 0.3 (no),

@@ -228,7 +228,7 @@ void check_stage(const Call& call, const Matrix3X& x_expected, const Matrix3X& v
 }  // namespace
 
 TEST_SUITE("ex07") {
-  // --- Exercise 7.1: the midpoint method ------------------------------------------------------
+  // --- Exercise ex07.1: the midpoint method ------------------------------------------------------
 
   TEST_CASE("ex07.1 one midpoint step of a spring worked by hand" * POINTS(2)) {
     // a = -w^2 x with w = 2 1/s, dt = 0.1 s, from x = 1 m, v = 0.5 m/s (along the x axis):
@@ -412,7 +412,7 @@ TEST_SUITE("ex07") {
     }
   }
 
-  // --- Exercise 7.2: classical Runge-Kutta (RK4) ----------------------------------------------
+  // --- Exercise ex07.2: classical Runge-Kutta (RK4) ----------------------------------------------
 
   TEST_CASE("ex07.2 one RK4 step of a spring worked by hand" * POINTS(2)) {
     // a = -w^2 x with w = 2 1/s, dt = 0.1 s, from x = 1 m, v = 0.5 m/s (along the x axis):

@@ -1,4 +1,4 @@
-# check_lesson_points.cmake: the points each lesson's README quotes ("## Exercise 2.1: ...
+# check_lesson_points.cmake: the points each lesson's README quotes ("## Exercise ex02.1: ...
 # (6 points)") are the points of that exercise's visible grading cases, as `clothlab grade
 # --list` shows them. The points live beside the test cases; this keeps the lessons honest.
 #
@@ -34,19 +34,15 @@ set(problems "")
 set(quoted "")
 file(GLOB readmes ${LESSONS}/[0-9][0-9]-*/README.md)
 foreach(readme ${readmes})
-  file(STRINGS ${readme} headings REGEX "^## Exercise [0-9]+\\.[0-9]+")
+  file(STRINGS ${readme} headings REGEX "^## Exercise ex[0-9]+\\.[0-9]+")
   file(RELATIVE_PATH shown ${LESSONS}/.. ${readme})
   foreach(heading ${headings})
-    if(NOT heading MATCHES "^## Exercise ([0-9]+)\\.([0-9]+).*\\(([0-9]+) points?\\)$")
+    if(NOT heading MATCHES "^## Exercise (ex[0-9][0-9]\\.[0-9]+).*\\(([0-9]+) points?\\)$")
       string(APPEND problems "\n  ${shown}: \"${heading}\" does not end with (N points)")
       continue()
     endif()
-    set(lesson ${CMAKE_MATCH_1})
-    if(lesson LESS 10)
-      set(lesson 0${lesson})
-    endif()
-    set(id ex${lesson}.${CMAKE_MATCH_2})
-    set(says ${CMAKE_MATCH_3})
+    set(id ${CMAKE_MATCH_1})
+    set(says ${CMAKE_MATCH_2})
     list(APPEND quoted ${id})
     if(NOT DEFINED points_${id})
       string(APPEND problems "\n  ${shown}: ${id} is quoted at ${says} points but has no case")
