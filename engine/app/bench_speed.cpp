@@ -49,7 +49,6 @@
 #include "app/submission.hpp"
 #include "clothlab/cloth.hpp"
 #include "clothlab/euler.hpp"
-#include "clothlab/fast_forces.hpp"
 #include "clothlab/gravity.hpp"
 #include "clothlab/implicit_euler.hpp"
 #include "clothlab/not_implemented.hpp"
@@ -58,6 +57,10 @@
 #include "clothlab/spring_damper.hpp"
 #include "clothlab/threads.hpp"
 #include "clothlab/world.hpp"
+#include "fast/copies.hpp"
+#include "fast/engine.hpp"
+#include "fast/forces.hpp"
+#include "fast/springs.hpp"
 
 extern char** environ;
 
@@ -262,9 +265,9 @@ struct KernelRun {
 
   void evaluate() {
     for (long pass = 0; pass < kPasses; ++pass) {
-      spring_forces_of_run(count, stride, stride, x.data(), x.data() + 1, v.data(), v.data() + 1,
-                           ks.data(), kd.data(), l0.data(), f1.data(), f1.data() + count,
-                           f1.data() + 2 * count);
+      fast::spring_forces_of_run(count, stride, stride, x.data(), x.data() + 1, v.data(),
+                                 v.data() + 1, ks.data(), kd.data(), l0.data(), f1.data(),
+                                 f1.data() + count, f1.data() + 2 * count);
     }
   }
 };
@@ -291,7 +294,7 @@ KernelRun kernel_run(const World& world) {
 
 // --- The engine's step without its copies and checks ---------------------------------------
 //
-// The reference step copies x and v into the fast layout and f back out (fast_forces.hpp), and
+// The reference step copies x and v into the fast layout and f back out (fast/engine.hpp), and
 // the guard checks the state before and after the step. `bare` keeps x, v and f in the fast
 // layout from one step to the next and checks nothing: the world's force effects add their
 // forces through their fast paths (the same code as the reference's), then symplectic Euler's
@@ -301,16 +304,19 @@ KernelRun kernel_run(const World& world) {
 
 struct BareCloth {
   const World* world = nullptr;
-  FastScratch state;  // x, v and f, rows spaced as on the engine's fast path
-  FastScratch next;   // x and v after the step: each block of particles moves here while
-                      // later blocks and other threads may still read its x and v in `state`
-  std::unique_ptr<ThreadTeam> team;  // null on 1 thread
+  fast::Copies state;  // x, v and f, rows spaced as on the engine's fast path
+  fast::Copies next;   // x and v after the step: each block of particles moves here while
+                       // later blocks and other threads may still read its x and v in `state`
+  std::vector<std::unique_ptr<fast::FastForce>> forces;  // the fast form of each force effect
+  std::unique_ptr<ThreadTeam> team;                      // null on 1 thread
 
-  // A copy of the world's state; every force effect must have a fast path.
+  // A copy of the world's state; every force effect must have a fast form.
   BareCloth(const World& w, int threads) : world(&w) {
-    prepare_fast_forces(w, state);
-    if (std::find(state.soa.begin(), state.soa.end(), 0) != state.soa.end()) {
-      throw std::logic_error("bench speed: bare: a force effect has no fast path");
+    for (const auto& effect : w.force_effects) {
+      forces.push_back(fast::fast_force(*effect));
+      if (!forces.back() || !forces.back()->prepare(w.particles)) {
+        throw std::logic_error("bench speed: bare: a force effect has no fast path");
+      }
     }
     const Index n = w.particles.size();
     state.resize(n);
@@ -324,9 +330,9 @@ struct BareCloth {
   Matrix3X velocities() const { return state.v.leftCols(world->particles.size()); }
 
   // As on the engine's fast path, each thread owns a contiguous range of particles and takes it
-  // a block at a time (World::pass_block): it sums the block's forces, then moves it into `next`.
+  // a block at a time (fast::kPassBlock): it sums the block's forces, then moves it into `next`.
   void step(double dt) {
-    const Index block = std::max<Index>(world->pass_block, 1);
+    const Index block = fast::kPassBlock;
     for_ranges(team.get(), world->particles.size(), [&](Index begin, Index end) {
       for (Index b0 = begin; b0 < end; b0 += block)
         step_range(b0, std::min(b0 + block, end), dt, next.x.data(), next.v.data());
@@ -341,15 +347,15 @@ struct BareCloth {
                                                   double* v_out) {
     const Particles& p = world->particles;
     state.f.middleCols(begin, end - begin).setZero();
-    for (const auto& effect : world->force_effects)
-      effect->add_forces_soa(p, state.x, state.v, state.f, begin, end);
+    for (const auto& force : forces)
+      force->add(p, state.x, state.v, state.f, begin, end);
     move_range(begin, end, dt, state.x.data(), state.x.cols(), state.v.data(), state.v.cols(),
                state.f.data(), state.f.cols(), p.inv_m.data(), x_out, v_out);
   }
 
   // Symplectic Euler on particles [begin, end), the fast layout in and out. A function of its
   // own so that the pointers can be declared not to overlap: GCC then vectorises the loop, as
-  // in the engine's move (euler.cpp).
+  // in the engine's move (fast/engine.cpp).
   [[gnu::flatten, gnu::noinline]] static void move_range(
       Index begin, Index end, double dt, const double* __restrict x, Index nx,
       const double* __restrict v, Index nv, const double* __restrict f, Index nf,

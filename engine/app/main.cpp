@@ -78,7 +78,7 @@ std::string particle_count(const Scene& scene) {
 
 // The --stats table: where the time of the run went, effect by effect (only those in play).
 void print_stats(const World& world, const StepTimes& times) {
-  double total = times.integrator + times.guard;
+  double total = times.integrator + times.guard + times.backend_forces + times.backend_steps;
   for (double s : times.force_effects)
     total += s;
   for (double s : times.post_step_effects)
@@ -88,12 +88,20 @@ void print_stats(const World& world, const StepTimes& times) {
                total > 0 ? 100.0 * seconds / total : 0.0);
   };
   fmt::print("  time per part of the step (--stats):\n");
+  // An effect the fast path took whole has no time of its own: it is not listed.
+  const bool fast = times.backend_steps > 0 || times.backend_forces > 0;
   for (size_t k = 0; k < times.force_effects.size(); ++k) {
-    row(world.force_effects[k]->name(), times.force_effects[k]);
+    if (!fast || times.force_effects[k] > 0)
+      row(world.force_effects[k]->name(), times.force_effects[k]);
   }
   for (size_t k = 0; k < times.post_step_effects.size(); ++k) {
-    row(world.post_step_effects[k]->name(), times.post_step_effects[k]);
+    if (!fast || times.post_step_effects[k] > 0)
+      row(world.post_step_effects[k]->name(), times.post_step_effects[k]);
   }
+  // What the fast engine (World::backend) took: its passes sum every effect at once, so they
+  // are timed as a whole. `[engine] fast_path = false` times each effect on its own instead.
+  if (times.backend_steps > 0) row("fast path: whole steps", times.backend_steps);
+  if (times.backend_forces > 0) row("fast path: force sums", times.backend_forces);
   row(fmt::format("{} (own)", world.integrator->name()), times.integrator);
   row("guard", times.guard);
   fmt::print("  force evaluations: {} ({} per step)\n", world.force_evaluations,

@@ -1,9 +1,13 @@
 #include "clothlab/aerodynamics.hpp"
 
-#include <algorithm>
-#include <utility>
+#include <atomic>
 
 namespace clothlab {
+
+unsigned long Aerodynamics::next_version() {
+  static std::atomic<unsigned long> changes{0};
+  return ++changes;
+}
 
 void Aerodynamics::add_forces(const Particles& /*p*/, const Matrix3X& x, const Matrix3X& v,
                               Matrix3X& f) const {
@@ -17,206 +21,9 @@ void Aerodynamics::add_forces(const Particles& /*p*/, const Matrix3X& x, const M
   }
 }
 
-// --- The fast path ---------------------------------------------------------------------------
-//
-// add_forces above is the lecture's loop. The fast path evaluates the exercise kernel (inlined at
-// link time) on four triangles at once, and every particle still sums the same numbers in the
-// same order as there. The list is cut into groups (triangle_groups):
-//
-// - a run, such as a grid's row: its triangles alternate between phases whose corners move one
-//   particle per triangle, so the kernel reads them straight from the fast path's rows. The
-//   shares go out in one pass per (phase, corner), in the order in which a particle meets them
-//   in the list (the pass with the earlier list position for every particle first);
-// - other triangles: their corners are gathered 128 at a time into rows of their own, and their
-//   shares go to the corners one triangle after the other, as add_forces adds them.
-//
-// A thread takes the triangles with a corner in its range and adds to those corners only.
-
-namespace {
-
-constexpr Index kTriangleChunk = 128;  // triangles per chunk: 21 KiB of gathered inputs
-
-// share = aerodynamic_force(...) / 3 of triangles i = 0 .. count - 1, whose corner c has its
-// components at xc[i], xc[nx + i], xc[2 nx + i] and its velocity's at vc[i], vc[nv + i], ...;
-// the shares go to rows 0-2 of `share`, kTriangleChunk apart. A run's corners are read where
-// they are; gathered ones from rows kTriangleChunk long. Not inlined, so that its pointers can be
-// declared not to overlap what it writes: then the compiler vectorises the loop.
-[[gnu::noinline, gnu::flatten]] void aerodynamic_shares(
-    Index count, Index nx, Index nv, const double* __restrict x1, const double* __restrict x2,
-    const double* __restrict x3, const double* __restrict v1, const double* __restrict v2,
-    const double* __restrict v3, double* __restrict share, const Vec3 v_air, double rho,
-    double cd) {
-  constexpr Index n = kTriangleChunk;
-  const auto at = [](const double* a, Index stride, Index i) {
-    return Vec3(a[i], a[stride + i], a[2 * stride + i]);
-  };
-  for (Index i = 0; i < count; ++i) {
-    const Vec3 f_aero =
-        aerodynamic_force(at(x1, nx, i), at(x2, nx, i), at(x3, nx, i), at(v1, nv, i), at(v2, nv, i),
-                          at(v3, nv, i), v_air, rho, cd);
-    const Vec3 s = f_aero / 3.0;  // each corner carries a third of the triangle
-    share[i] = s.x();
-    share[n + i] = s.y();
-    share[2 * n + i] = s.z();
-  }
-}
-
-// dst[i] += src[i], i = 0 .. count - 1.
-void add_row(Index count, const double* __restrict src, double* __restrict dst) {
-  for (Index i = 0; i < count; ++i)
-    dst[i] += src[i];
-}
-
-}  // namespace
-
-void Aerodynamics::add_triangles_soa(size_t k_begin, size_t k_end, const SoA3& x, const SoA3& v,
-                                     SoA3& f, Index begin, Index end) const {
-  constexpr Index n = kTriangleChunk;
-  const auto in_range = [&](Index i) { return begin <= i && i < end; };
-  double in[18 * n];
-  double share[3 * n];
-  size_t chunk[n];  // which triangle each column of `in` holds
-  for (size_t k = k_begin; k < k_end;) {
-    Index count = 0;
-    for (; k < k_end && count < n; ++k) {
-      const Triangle& t = triangles_[k];
-      if (!in_range(t[0]) && !in_range(t[1]) && !in_range(t[2])) continue;
-      chunk[count] = k;
-      for (int c = 0; c < 3; ++c) {
-        for (int d = 0; d < 3; ++d) {
-          in[(3 * c + d) * n + count] = x(d, t[c]);
-          in[(9 + 3 * c + d) * n + count] = v(d, t[c]);
-        }
-      }
-      ++count;
-    }
-    // Rows of `in`: x, y, z of corners 1, 2, 3, then their velocities.
-    aerodynamic_shares(count, n, n, in, in + 3 * n, in + 6 * n, in + 9 * n, in + 12 * n,
-                       in + 15 * n, share, v_air_, rho_, cd_);
-    for (Index q = 0; q < count; ++q) {
-      for (Index corner : triangles_[chunk[q]]) {
-        if (!in_range(corner)) continue;
-        for (int d = 0; d < 3; ++d)
-          f(d, corner) += share[d * n + q];
-      }
-    }
-  }
-}
-
-std::vector<Aerodynamics::TriangleGroup> Aerodynamics::triangle_groups(
-    const std::vector<Triangle>& triangles) {
-  constexpr Index kMinRun = 8;  // shorter runs cost more in bookkeeping than they save
-  std::vector<TriangleGroup> groups;
-  const size_t count = triangles.size();
-  const auto shifted = [](const Triangle& t, Index i) {
-    return Triangle{t[0] + i, t[1] + i, t[2] + i};
-  };
-  for (size_t k = 0; k < count;) {
-    TriangleGroup run;
-    for (int period : {2, 1}) {
-      if (k + static_cast<size_t>(period) > count) continue;
-      Index length = 1;
-      const auto continues = [&](Index i) {
-        const size_t at = k + static_cast<size_t>(period * i);
-        if (at + static_cast<size_t>(period) > count) return false;
-        for (int p = 0; p < period; ++p) {
-          if (triangles[at + static_cast<size_t>(p)] != shifted(triangles[k + p], i)) return false;
-        }
-        return true;
-      };
-      while (continues(length))
-        ++length;
-      if (length >= kMinRun) {
-        run = {k, static_cast<size_t>(period * length), true, period, length, {}, {}};
-        break;
-      }
-    }
-    if (!run.run) {
-      // One more triangle taken one by one: with the previous ones if they were too.
-      if (groups.empty() || groups.back().run) groups.push_back({k, 0, false, 1, 0, {}, {}});
-      ++groups.back().size;
-      ++k;
-      continue;
-    }
-    // Particle q is corner c of phase p's triangle i = q - base[p][c], at list position
-    // k0 + period (q - base[p][c]) + p: its shares arrive in the order of p - period base[p][c],
-    // then of c (a triangle adds to its corners in order).
-    std::vector<std::array<int, 2>> order;
-    for (int p = 0; p < run.period; ++p) {
-      run.base[static_cast<size_t>(p)] = triangles[k + static_cast<size_t>(p)];
-      for (int c = 0; c < 3; ++c)
-        order.push_back({p, c});
-    }
-    const auto key = [&](const std::array<int, 2>& pc) {
-      return std::pair(
-          pc[0] - run.period * run.base[static_cast<size_t>(pc[0])][static_cast<size_t>(pc[1])],
-          pc[1]);
-    };
-    std::sort(order.begin(), order.end(),
-              [&](const auto& a, const auto& b) { return key(a) < key(b); });
-    std::copy(order.begin(), order.end(), run.order.begin());
-    groups.push_back(run);
-    k += run.size;
-  }
-  return groups;
-}
-
-void Aerodynamics::add_group_soa(const TriangleGroup& g, const SoA3& x, const SoA3& v, SoA3& f,
-                                 Index begin, Index end) const {
-  if (!g.run) {
-    add_triangles_soa(g.k0, g.k0 + g.size, x, v, f, begin, end);
-    return;
-  }
-  constexpr Index n = kTriangleChunk;
-  const size_t passes = static_cast<size_t>(3 * g.period);
-  // The triangles i with a corner in [begin, end).
-  Index lowest = g.base[0][0], highest = lowest;
-  for (int p = 0; p < g.period; ++p) {
-    for (Index corner : g.base[static_cast<size_t>(p)]) {
-      lowest = std::min(lowest, corner);
-      highest = std::max(highest, corner);
-    }
-  }
-  const Index i_begin = std::clamp<Index>(begin - highest, 0, g.length);
-  const Index i_end = std::clamp<Index>(end - lowest, 0, g.length);
-  double share[2][3 * n];
-  for (Index i0 = i_begin; i0 < i_end; i0 += n) {
-    const Index i1 = std::min(i0 + n, i_end);
-    for (int p = 0; p < g.period; ++p) {
-      const Triangle& b = g.base[static_cast<size_t>(p)];
-      aerodynamic_shares(i1 - i0, x.cols(), v.cols(), x.data() + b[0] + i0, x.data() + b[1] + i0,
-                         x.data() + b[2] + i0, v.data() + b[0] + i0, v.data() + b[1] + i0,
-                         v.data() + b[2] + i0, share[static_cast<size_t>(p)], v_air_, rho_, cd_);
-    }
-    // Every particle takes its shares in the list's order: pass by pass (see triangle_groups).
-    for (size_t k = 0; k < passes; ++k) {
-      const auto [p, c] = g.order[k];
-      const Index corner = g.base[static_cast<size_t>(p)][static_cast<size_t>(c)];
-      const Index t0 = std::max(i0, begin - corner), t1 = std::min(i1, end - corner);
-      if (t0 >= t1) continue;
-      for (Index d = 0; d < 3; ++d) {
-        add_row(t1 - t0, share[static_cast<size_t>(p)] + d * n + (t0 - i0),
-                f.data() + d * f.cols() + corner + t0);
-      }
-    }
-  }
-}
-
-void Aerodynamics::add_forces_soa(const Particles& /*p*/, const SoA3& x, const SoA3& v, SoA3& f,
-                                  Index begin, Index end) const {
-  for (const TriangleGroup& g : groups_)
-    add_group_soa(g, x, v, f, begin, end);
-}
-
 void FluidDrag::add_forces(const Particles& p, const Matrix3X& /*x*/, const Matrix3X& v,
                            Matrix3X& f) const {
   for (Index i = 0; i < p.size(); ++i)
-    f.col(i) += fluid_drag_force(v.col(i), v_air_, rho_, cd_, area_);
-}
-
-void FluidDrag::add_forces_soa(const Particles& /*p*/, const SoA3& /*x*/, const SoA3& v, SoA3& f,
-                               Index begin, Index end) const {
-  for (Index i = begin; i < end; ++i)
     f.col(i) += fluid_drag_force(v.col(i), v_air_, rho_, cd_, area_);
 }
 

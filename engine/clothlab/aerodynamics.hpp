@@ -16,7 +16,6 @@
 // triangle's winding flips n, but (v . n) n is unchanged, so the force does not depend on it.
 #pragma once
 
-#include <array>
 #include <vector>
 
 #include "clothlab/effect.hpp"
@@ -51,47 +50,24 @@ class Aerodynamics final : public ForceEffect {
   double energy_scale(const Particles& p, const Matrix3X& /*x*/, double /*size*/) const override {
     return 0.5 * p.m.sum() * v_air_.squaredNorm();
   }
-  // The fast path (fast_forces.hpp): the same forces, the kernel on several triangles at once.
-  bool adds_soa(const Particles& /*p*/) const override {
-    if (!groups_built_) groups_ = triangle_groups(triangles_);
-    groups_built_ = true;
-    return true;
-  }
-  void add_forces_soa(const Particles& p, const SoA3& x, const SoA3& v, SoA3& f, Index begin,
-                      Index end) const override;
+  double rho() const { return rho_; }  // [kg/m^3]
+  double cd() const { return cd_; }
   const std::vector<Triangle>& triangles() const { return triangles_; }
   // Drops the triangles a tear has opened (lesson 06).
   template <class Predicate>
   void remove_triangles_if(Predicate torn) {
     std::erase_if(triangles_, torn);
-    groups_built_ = false;
+    version_ = next_version();
   }
-
-  // A stretch of the triangle list seen by the fast path (aerodynamics.cpp). In a run, the list's
-  // triangles k0, k0 + 1, ... alternate between `period` phases, and triangle i of phase p (list
-  // position k0 + period i + p) has corners base[p][0] + i, base[p][1] + i, base[p][2] + i: a
-  // grid's two triangles per cell along a row. Otherwise its triangles are taken one by one.
-  struct TriangleGroup {
-    size_t k0 = 0, size = 0;  // list positions [k0, k0 + size)
-    bool run = false;
-    int period = 1;    // phases (1 or 2)
-    Index length = 0;  // triangles per phase
-    std::array<Triangle, 2> base{};
-    // Corner shares in the order a particle receives them in the list: (phase, corner) pairs.
-    std::array<std::array<int, 2>, 6> order{};
-  };
-  // The triangle list cut into groups, in order, covering every triangle once.
-  static std::vector<TriangleGroup> triangle_groups(const std::vector<Triangle>& triangles);
+  // Which change of the triangle list this effect is at: a number no other change, of any
+  // effect, has had (as SpringSet::version). What keeps a view of the list compares it.
+  unsigned long version() const { return version_; }
 
  private:
-  void add_group_soa(const TriangleGroup& g, const SoA3& x, const SoA3& v, SoA3& f, Index begin,
-                     Index end) const;
-  void add_triangles_soa(size_t k_begin, size_t k_end, const SoA3& x, const SoA3& v, SoA3& f,
-                         Index begin, Index end) const;
+  static unsigned long next_version();
 
   std::vector<Triangle> triangles_;
-  mutable std::vector<TriangleGroup> groups_;  // the fast path's view of triangles_
-  mutable bool groups_built_ = false;
+  unsigned long version_ = next_version();
   double rho_;  // air density [kg/m^3]
   double cd_;   // drag coefficient
   Vec3 v_air_;  // wind velocity [m/s]
@@ -108,10 +84,10 @@ class FluidDrag final : public ForceEffect {
   double energy_scale(const Particles& p, const Matrix3X& /*x*/, double /*size*/) const override {
     return 0.5 * p.m.sum() * v_air_.squaredNorm();
   }
-  // The fast path (fast_forces.hpp): the same force on the structure-of-arrays state.
-  bool adds_soa(const Particles& /*p*/) const override { return true; }
-  void add_forces_soa(const Particles& p, const SoA3& x, const SoA3& v, SoA3& f, Index begin,
-                      Index end) const override;
+  double rho() const { return rho_; }  // [kg/m^3]
+  double cd() const { return cd_; }
+  double area() const { return area_; }                  // [m^2]
+  const Vec3& fluid_velocity() const { return v_air_; }  // [m/s]
 
  private:
   double rho_;   // fluid density [kg/m^3]

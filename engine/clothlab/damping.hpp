@@ -21,10 +21,7 @@ class Damping final : public ForceEffect {
   // df_i/dv_i = -rate m_i I.
   bool add_jacobians(const Particles& p, const Matrix3X& x, const Matrix3X& v,
                      ForceJacobians& jacobians) const override;
-  // The fast path (fast_forces.hpp): the same force on the structure-of-arrays state.
-  bool adds_soa(const Particles& /*p*/) const override { return true; }
-  void add_forces_soa(const Particles& p, const SoA3& x, const SoA3& v, SoA3& f, Index begin,
-                      Index end) const override;
+  double rate() const { return rate_; }  // [1/s]
 
  private:
   double rate_;  // damping rate [1/s]

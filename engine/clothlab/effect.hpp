@@ -35,15 +35,6 @@ class ForceJacobians {
   virtual void add_self(Index i, const Mat3& dfdx, const Mat3& dfdv) = 0;
 };
 
-// Per-particle vectors stored as a structure of arrays for the fast path (fast_forces.hpp): the
-// x components of every particle, then the y components, then the z components, each row
-// contiguous. Column i is still particle i (s.col(i) is a Vec3 expression), but a loop over
-// particles reads each component in memory order, which lets the compiler vectorise it. The fast
-// path's copies have a few more columns than there are particles (fast_forces.cpp says why), so
-// row c of s starts at s.data() + c * s.cols(): use s.cols() as the stride, never the number
-// of particles.
-using SoA3 = Eigen::Matrix<double, 3, Eigen::Dynamic, Eigen::RowMajor>;
-
 class ForceEffect {
  public:
   virtual ~ForceEffect() = default;
@@ -86,18 +77,6 @@ class ForceEffect {
                              ForceJacobians& /*jacobians*/) const {
     return false;
   }
-
-  // The fast path (fast_forces.hpp). An effect that can add its forces on the structure-of-
-  // arrays copy of the state says so here, and may update what it caches for it (called once
-  // per evaluation, on one thread). The others make the world take the readable path.
-  virtual bool adds_soa(const Particles& /*p*/) const { return false; }
-
-  // The same forces as add_forces on particles [begin, end) only, added into those columns of
-  // f, with the same floating-point operations on each particle in the same order, so that the
-  // two paths agree bit for bit. It reads x and v anywhere (a spring reaches out of the range)
-  // and writes f nowhere else: the fast path gives different ranges to different threads.
-  virtual void add_forces_soa(const Particles& /*p*/, const SoA3& /*x*/, const SoA3& /*v*/,
-                              SoA3& /*f*/, Index /*begin*/, Index /*end*/) const {}
 };
 
 class PostStepEffect {
@@ -109,16 +88,6 @@ class PostStepEffect {
   // whole world: some post-step effects change more than particles (tearing removes springs
   // and triangles).
   virtual void apply(World& world, double dt) = 0;
-
-  // Whether apply changes each particle from that particle's own position, velocity and mass
-  // alone, and nothing else (a ground, a sphere). A step whose integrator moves every particle
-  // in one pass then applies the effect in that pass, range by range, right after moving each
-  // range (apply_range), while those particles are still in the cache, instead of in a pass of
-  // its own over the whole state (World::step).
-  virtual bool acts_per_particle() const { return false; }
-  // apply on particles [begin, end) only, for an effect that acts_per_particle. Threads may call
-  // it on different ranges at once.
-  virtual void apply_range(Particles& /*p*/, double /*dt*/, Index /*begin*/, Index /*end*/) const {}
 };
 
 }  // namespace clothlab

@@ -37,7 +37,6 @@ class ExplicitEuler final : public Integrator {
   std::string_view name() const override { return "explicit-euler"; }
   void advance(World& world, double dt) override;
   int force_evaluations_per_step() const override { return 1; }
-  bool moves_in_one_pass() const override { return true; }
 };
 
 class SymplecticEuler final : public Integrator {
@@ -45,7 +44,6 @@ class SymplecticEuler final : public Integrator {
   std::string_view name() const override { return "symplectic-euler"; }
   void advance(World& world, double dt) override;
   int force_evaluations_per_step() const override { return 1; }
-  bool moves_in_one_pass() const override { return true; }
 };
 
 }  // namespace clothlab

@@ -26,10 +26,6 @@ class UniformGravity final : public ForceEffect {
     return std::abs(potential_energy(p, x) - potential_energy(p, x0));
   }
   const Vec3& g() const { return g_; }
-  // The fast path (fast_forces.hpp): the same force on the structure-of-arrays state.
-  bool adds_soa(const Particles& /*p*/) const override { return true; }
-  void add_forces_soa(const Particles& p, const SoA3& x, const SoA3& v, SoA3& f, Index begin,
-                      Index end) const override;
 
  private:
   Vec3 g_;  // gravitational acceleration [m/s^2]

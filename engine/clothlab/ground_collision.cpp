@@ -19,14 +19,13 @@ PointState respond(const Vec3& r, const Vec3& v, const Vec3& n, double depth,
 
 }  // namespace
 
-void Ground::apply(World& world, double dt) {
-  apply_range(world.particles, dt, 0, world.particles.size());
+void Ground::apply(World& world, double /*dt*/) {
+  collide(world.particles, 0, world.particles.size());
 }
 
 // `flatten`: the exercise's collision_response inlined at link time, as the engine's other loops
 // inline their kernels. GCC otherwise calls it once per particle in contact.
-[[gnu::flatten]] void Ground::apply_range(Particles& p, double /*dt*/, Index begin,
-                                          Index end) const {
+[[gnu::flatten]] void Ground::collide(Particles& p, Index begin, Index end) const {
   const Vec3 up = Vec3::UnitY();
   for (Index i = begin; i < end; ++i) {
     const double depth = y0_ - p.x(1, i);
@@ -46,12 +45,11 @@ void Ground::apply(World& world, double dt) {
   }
 }
 
-void Sphere::apply(World& world, double dt) {
-  apply_range(world.particles, dt, 0, world.particles.size());
+void Sphere::apply(World& world, double /*dt*/) {
+  collide(world.particles, 0, world.particles.size());
 }
 
-[[gnu::flatten]] void Sphere::apply_range(Particles& p, double /*dt*/, Index begin,
-                                          Index end) const {
+[[gnu::flatten]] void Sphere::collide(Particles& p, Index begin, Index end) const {
   for (Index i = begin; i < end; ++i) {
     const Vec3 d = p.x.col(i) - centre_;
     const double distance = d.norm();

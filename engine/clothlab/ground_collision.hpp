@@ -45,8 +45,9 @@ class Ground final : public PostStepEffect {
       : y0_(y0), material_(material), model_(model), friction_(friction) {}
   std::string_view name() const override { return "ground"; }
   void apply(World& world, double dt) override;
-  bool acts_per_particle() const override { return true; }
-  void apply_range(Particles& p, double dt, Index begin, Index end) const override;
+  // apply's loop on particles [begin, end) only: each particle is pushed out from its own state
+  // alone, so ranges may be taken apart (and by different threads at once).
+  void collide(Particles& p, Index begin, Index end) const;
   double y0() const { return y0_; }
 
  private:
@@ -63,8 +64,8 @@ class Sphere final : public PostStepEffect {
       : centre_(centre), radius_(radius), material_(material) {}
   std::string_view name() const override { return "sphere"; }
   void apply(World& world, double dt) override;
-  bool acts_per_particle() const override { return true; }
-  void apply_range(Particles& p, double dt, Index begin, Index end) const override;
+  // apply's loop on particles [begin, end) only (as Ground::collide).
+  void collide(Particles& p, Index begin, Index end) const;
   const Vec3& centre() const { return centre_; }
   double radius() const { return radius_; }
 

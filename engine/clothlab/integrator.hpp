@@ -26,11 +26,6 @@ class Integrator {
   // Force evaluations per step, for reports ("4" for RK4). The implicit integrator also solves
   // a linear system; its cost is in its own statistics.
   virtual int force_evaluations_per_step() const = 0;
-
-  // True when advance is one call of world.compute_forces_then at the state the step starts
-  // from, and nothing else (the Euler methods): the world may then let that call's passes over
-  // the particles check the state for the guard before and after the step (World::step).
-  virtual bool moves_in_one_pass() const { return false; }
 };
 
 // The names a scene may give in [integrator] method = "...".

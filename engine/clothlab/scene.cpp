@@ -12,6 +12,7 @@
 
 #include "clothlab/scene_reader.hpp"
 #include "clothlab/scene_tables.hpp"
+#include "fast/engine.hpp"
 
 namespace clothlab {
 
@@ -453,6 +454,8 @@ Scene parse_scene(std::string_view text, const std::string& source) {
     }
   }
 
+  // The engine's fast path, unless [engine] says fast_path = false.
+  scene.world.backend = fast::make_fast_engine();
   // Read the tables in the order the engine needs them (particles before the effects on them).
   for (const SceneTableKind& kind : scene_table_kinds()) {
     const toml::node* node = root.get(kind.name);

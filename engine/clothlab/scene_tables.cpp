@@ -522,7 +522,7 @@ void read_guard(SceneTable& t, Scene& scene) {
 void read_engine(SceneTable& t, Scene& scene) {
   World& world = scene.world;
   world.threads = static_cast<int>(t.integer("threads", 1, 1024, world.threads));
-  world.fast_path = t.boolean("fast_path", world.fast_path);
+  if (!t.boolean("fast_path", true)) world.backend.reset();
 }
 
 // The order here is the order of reading: the guard's bounds, which the particles must start

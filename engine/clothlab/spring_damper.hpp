@@ -54,9 +54,9 @@ double spring_energy(const Vec3& r1, const Vec3& r2, double ks, double l0);
 // as built, l_built(k) [m] (plasticity, lesson 06, keeps l0 within limits of l_built).
 //
 // The arrays are read through i(), j(), ks(), ... and changed only through the methods below.
-// The fast path keeps a description of the ends and the constants (see SpringRun), and every
+// The fast engine (engine/fast/) keeps a description of the ends and the constants, and every
 // method that changes one of them moves version() to a number no other change, of any set, has
-// had: the fast path compares it before every use, in every build, so it never computes with a
+// had: the fast engine compares it before every use, in every build, so it never computes with a
 // description of springs that are no longer there. The rest lengths change freely (plasticity
 // changes them every step): no description holds them.
 class SpringSet {
@@ -100,44 +100,14 @@ class SpringSet {
   unsigned long version_ = 0;
 };
 
-// A stretch of springs that join consecutive particles: springs k0, k0 + 1, ..., k0 + length - 1
-// of a set join particles i0 + t and j0 + t, t = 0, 1, ..., length - 1. A grid's families come in
-// such runs (the row springs of row r are one, with j0 = i0 + 1), so a loop over a run reads
-// positions and writes forces in memory order, with no index arrays to chase.
-struct SpringRun {
-  size_t k0;             // first spring of the run in the set
-  Index i0, j0;          // particles of its first spring
-  Index length;          // springs in the run
-  bool uniform = false;  // all its springs have the ks and the kd of its first, bit for bit
-  bool operator==(const SpringRun&) const = default;
-};
-
-// The springs of `s`, in their order, cut into the longest runs they form. A set without such
-// structure comes out as runs of length 1; the runs always cover every spring exactly once. A
-// run is `uniform` when its springs share one ks and one kd (a family added by
-// add_spring_family): the fast path then reads them once for the run.
-std::vector<SpringRun> spring_runs(const SpringSet& s);
-
-// The fast path's inner loop: the forces f1 of springs t = 0 .. count - 1 of a run, through
-// spring_damper_force. Spring t joins the particles whose components sit at x1[t], x1[nx + t],
-// x1[2 nx + t] and x2[t], ... (nx: the stride of x's rows), with velocities at v1[t],
-// v1[nv + t], ...; its constants are ks[t], kd[t], l0[t], and f1 goes to f1x[t], f1y[t],
-// f1z[t]. No two arrays may overlap. Compiled with the kernel inlined (link-time optimisation),
-// it evaluates four or eight springs at once; `clothlab bench speed` times it alone. With
-// `uniform`, every spring has the constants ks[0] and kd[0] (SpringRun::uniform).
-void spring_forces_of_run(Index count, Index nx, Index nv, const double* x1, const double* x2,
-                          const double* v1, const double* v2, const double* ks, const double* kd,
-                          const double* l0, double* f1x, double* f1y, double* f1z,
-                          bool uniform = false);
-
 // The spring effect of `world` called `name` ("springs" or "bending"), or nullptr.
 SpringDampers* find_spring_effect(World& world, std::string_view name);
 const SpringDampers* find_spring_effect(const World& world, std::string_view name);
 
 // Appends one spring per pair (a, b), joining particles first + a and first + b, with rest
 // lengths measured in x (the distance at build time). The pairs are added sorted by (b - a, a),
-// so that a grid's springs form long runs (see SpringRun): the row springs of a cloth, then its
-// column springs, and so on, whatever order the builder listed them in.
+// so that a grid's springs form long runs (engine/fast/springs.hpp): the row springs of a cloth,
+// then its column springs, and so on, whatever order the builder listed them in.
 void add_spring_family(SpringSet& springs, const std::vector<std::pair<Index, Index>>& pairs,
                        Index first, double ks, double kd, const Matrix3X& x);
 
@@ -156,35 +126,9 @@ class SpringDampers final : public ForceEffect {
   const SpringSet& springs() const { return springs_; }
   SpringSet& springs() { return springs_; }
 
-  // The fast path (fast_forces.hpp): the same forces, run by run (see SpringRun). A set that
-  // forms few runs (springs listed in no particular order) is left to add_forces. A run whose
-  // ends are kDirectGap or more particles apart adds each force straight to both ends; closer
-  // ones go through a small buffer (spring_damper.cpp says why).
-  static constexpr Index kDirectGap = 16;
-  bool adds_soa(const Particles& p) const override;
-  void add_forces_soa(const Particles& p, const SoA3& x, const SoA3& v, SoA3& f, Index begin,
-                      Index end) const override;
-
  private:
-  // Adds the forces of the springs of `run` on the particles [p_begin, p_end) to f.
-  void add_run(const SpringRun& run, Index p_begin, Index p_end, const SoA3& x, const SoA3& v,
-               SoA3& f) const;
-  // The same for a run whose ends are kDirectGap or more apart (spring_damper.cpp), without the
-  // buffer: springs [up_begin, up_end) have their upper end in range, [lo_begin, lo_end) their
-  // lower end.
-  void add_run_direct(const SpringRun& run, Index up_begin, Index up_end, Index lo_begin,
-                      Index lo_end, const SoA3& x, const SoA3& v, SoA3& f) const;
-
   std::string name_;
   SpringSet springs_;
-
-  // The fast path's view of springs_, built again when springs_.version() changes.
-  struct RunLayout {
-    bool built = false;
-    unsigned long version = 0;
-    std::vector<SpringRun> runs;
-  };
-  mutable RunLayout layout_;
 };
 
 }  // namespace clothlab

@@ -1,9 +1,9 @@
-// threads.hpp: a small team of threads that the fast path splits a step over.
+// threads.hpp: a small team of threads that a step's passes over the particles are split over.
 //
 // The team is made once (World keeps it) and sleeps between jobs, so a step pays for waking the
 // threads, not for starting them. The work is split by the caller, never by the team: each
 // thread gets a contiguous range of particles, and a step's result does not depend on how many
-// threads took it (see fast_forces.hpp).
+// threads took it (see engine/fast/engine.hpp).
 #pragma once
 
 #include <atomic>

@@ -2,85 +2,68 @@
 
 #include <cassert>
 #include <chrono>
-#include <utility>
-
-#include "clothlab/fast_forces.hpp"
 
 namespace clothlab {
 
 namespace {
-using Clock = std::chrono::steady_clock;
-double seconds_since(Clock::time_point start) {
-  return std::chrono::duration<double>(Clock::now() - start).count();
-}
+
+// Adds the wall time from its making to its end to *slot, and takes it from *less: a part of
+// the step timed for --stats (World::timing). Without a slot it does nothing.
+class Lap {
+ public:
+  explicit Lap(double* slot, double* less = nullptr) : slot_(slot), less_(less) {
+    if (slot_) start_ = std::chrono::steady_clock::now();
+  }
+  ~Lap() {
+    if (!slot_) return;
+    const double s =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
+    *slot_ += s;
+    if (less_) *less_ -= s;
+  }
+  Lap(const Lap&) = delete;
+  Lap& operator=(const Lap&) = delete;
+
+ private:
+  double* slot_;
+  double* less_;
+  std::chrono::steady_clock::time_point start_;
+};
+
 }  // namespace
 
 void World::step(double dt) {
   assert(integrator && "a world needs an integrator before it can step");
   if (steps == 0) guard.start(*this);
-  if (!timing) {
-    // The state the step starts from: the last step left it valid, but code between steps may
-    // have changed it. The guard checks it (one vectorised pass) and names the particle before
-    // a NaN can spread. An integrator that moves every particle in one pass has that pass check
-    // each particle before anything moves, and after moving it when nothing else follows
-    // (StepChecks): the same checks, without two more passes over the whole state.
-    // The post-step effects that act on each particle alone, from the front of the list, go
-    // into that pass as well: each range of particles meets them right after it moves, in the
-    // order of the list, as it would in passes of their own. The others follow the step.
-    step_checks_ = StepChecks{};
-    size_t in_pass = 0;
-    // It captures `this` alone, so that std::function keeps it without allocating.
-    const std::function<void(Index, Index)> after_move = [this](Index begin, Index end) {
-      for (size_t k = 0; k < step_checks_.post_in_pass; ++k)
-        post_step_effects[k]->apply_range(particles, step_checks_.dt, begin, end);
-    };
-    if (integrator->moves_in_one_pass()) {
-      while (in_pass < post_step_effects.size() && post_step_effects[in_pass]->acts_per_particle())
-        ++in_pass;
-      step_checks_.armed = true;
-      step_checks_.end = in_pass == post_step_effects.size();
-      step_checks_.post_in_pass = in_pass;
-      step_checks_.dt = dt;
-      if (in_pass > 0) step_checks_.after_move = &after_move;
-    } else {
-      guard.check(*this, /*before_step=*/true);
-    }
-    integrator->advance(*this, dt);  // calls compute_forces (steps 1-2) as often as it needs
-    assert(!step_checks_.armed &&
-           "moves_in_one_pass, but advance did not call compute_forces_then");
-    step_checks_.after_move = nullptr;
-    for (size_t k = in_pass; k < post_step_effects.size(); ++k)
-      post_step_effects[k]->apply(*this, dt);
-    t += dt;
-    ++steps;
-    if (!(step_checks_.end_checked && step_checks_.end_within)) guard.check(*this);
-    if (steps % guard.energy_check_every == 0) guard.check_energy(*this);
-    return;
+  if (timing) {
+    timing->force_effects.resize(force_effects.size(), 0.0);
+    timing->post_step_effects.resize(post_step_effects.size(), 0.0);
   }
-  guard.check(*this, /*before_step=*/true);
-  // The same step, timed part by part (for --stats).
-  timing->force_effects.resize(force_effects.size(), 0.0);
-  timing->post_step_effects.resize(post_step_effects.size(), 0.0);
-  double forces_before = 0.0;
-  for (double s : timing->force_effects)
-    forces_before += s;
-  Clock::time_point start = Clock::now();
-  integrator->advance(*this, dt);
-  double forces_after = 0.0;
-  for (double s : timing->force_effects)
-    forces_after += s;
-  timing->integrator += seconds_since(start) - (forces_after - forces_before);
-  for (size_t k = 0; k < post_step_effects.size(); ++k) {
-    start = Clock::now();
-    post_step_effects[k]->apply(*this, dt);
-    timing->post_step_effects[k] += seconds_since(start);
+  // The backend goes first; what it took of the step it did the lecture's way, bit for bit.
+  BackendStep fast;
+  if (backend) {
+    Lap lap(timing ? &timing->backend_steps : nullptr);
+    fast = backend->step(*this, dt);
+  }
+  if (!fast.taken) {
+    {
+      Lap lap(timing ? &timing->guard : nullptr);
+      guard.check(*this, /*before_step=*/true);  // 5: the state the step starts from
+    }
+    Lap lap(timing ? &timing->integrator : nullptr);  // compute_forces takes its own time out
+    integrator->advance(*this, dt);  // 1-3: forces, as often as it needs, then motion
+  }
+  for (size_t k = fast.post_step_done; k < post_step_effects.size(); ++k) {
+    Lap lap(timing ? &timing->post_step_effects[k] : nullptr);
+    post_step_effects[k]->apply(*this, dt);  // 4: collisions, plasticity, tearing
   }
   t += dt;
   ++steps;
-  start = Clock::now();
-  guard.check(*this);
+  // 5: the state the step ends with, unless the backend checked every particle after its move
+  // and nothing has changed it since.
+  Lap lap(timing ? &timing->guard : nullptr);
+  if (!fast.checked_after || fast.post_step_done < post_step_effects.size()) guard.check(*this);
   if (steps % guard.energy_check_every == 0) guard.check_energy(*this);
-  timing->guard += seconds_since(start);
 }
 
 ThreadTeam* World::team() const {
@@ -90,41 +73,15 @@ ThreadTeam* World::team() const {
 }
 
 void World::compute_forces(const Matrix3X& x, const Matrix3X& v, Matrix3X& f) const {
-  if (!takes_fast_path() || !prepare_fast_forces(*this, fast_)) {
-    compute_forces_readable(x, v, f);
-    return;
+  if (backend) {
+    Lap lap(timing ? &timing->backend_forces : nullptr, timing ? &timing->integrator : nullptr);
+    if (backend->sum_forces(*this, x, v, f)) {
+      ++force_evaluations;
+      ++fast_evaluations;
+      return;
+    }
   }
-  ++force_evaluations;
-  ++fast_evaluations;
-  fast_forces(*this, x, v, f, fast_, team());
-}
-
-void World::compute_forces_then(const Matrix3X& x, const Matrix3X& v, Matrix3X& f,
-                                const MoveRange& move) const {
-  // The step's own pass (World::step armed its checks): (x, v) is the state it starts from.
-  const bool step_pass = std::exchange(step_checks_.armed, false);
-  assert((!step_pass || (&x == &particles.x && &v == &particles.v)) &&
-         "compute_forces_then of a step moves the particles' own state");
-  // The step's post-step effects that ride along (StepChecks::after_move): each range meets
-  // them right after it moves.
-  MoveRange move_then_after;
-  const MoveRange* moves = &move;
-  if (step_pass && step_checks_.after_move) {
-    move_then_after = [&](Index begin, Index end, const FastScratch* copies) {
-      move(begin, end, copies);
-      (*step_checks_.after_move)(begin, end);
-    };
-    moves = &move_then_after;
-  }
-  if (!takes_fast_path() || !prepare_fast_forces(*this, fast_)) {
-    if (step_pass) guard.check(*this, /*before_step=*/true);
-    compute_forces_readable(x, v, f);
-    for_particles([&](Index begin, Index end) { (*moves)(begin, end, nullptr); });
-    return;
-  }
-  ++force_evaluations;
-  ++fast_evaluations;
-  fast_forces(*this, x, v, f, fast_, team(), moves, step_pass ? &step_checks_ : nullptr);
+  compute_forces_readable(x, v, f);
 }
 
 void World::for_particles(const std::function<void(Index begin, Index end)>& range) const {
@@ -134,16 +91,10 @@ void World::for_particles(const std::function<void(Index begin, Index end)>& ran
 void World::compute_forces_readable(const Matrix3X& x, const Matrix3X& v, Matrix3X& f) const {
   f.setZero();
   ++force_evaluations;
-  if (!timing) {
-    for (const auto& effect : force_effects)
-      effect->add_forces(particles, x, v, f);
-    return;
-  }
-  timing->force_effects.resize(force_effects.size(), 0.0);
+  if (timing) timing->force_effects.resize(force_effects.size(), 0.0);
   for (size_t k = 0; k < force_effects.size(); ++k) {
-    const Clock::time_point start = Clock::now();
+    Lap lap(timing ? &timing->force_effects[k] : nullptr, timing ? &timing->integrator : nullptr);
     force_effects[k]->add_forces(particles, x, v, f);
-    timing->force_effects[k] += seconds_since(start);
   }
 }
 

@@ -92,7 +92,7 @@ TEST_CASE("guard: a calm run is never stopped") {
 namespace {
 
 // A hanging cloth, 24 x 20, springs and gravity: every force effect has a fast path, so with
-// the Euler methods a step is one pass that also checks the state (World::step, StepChecks).
+// the Euler methods a step is one pass that also checks the state (fast/engine.hpp).
 // `extra` adds tables; `ks` and `dt` set how stable it is.
 clothlab::Scene hanging_cloth(const std::string& method, double ks, double dt,
                               const std::string& extra = "") {
@@ -151,7 +151,7 @@ TEST_CASE("guard: a state spoiled between steps stops the next step before anyth
     CAPTURE(s.threads);
     clothlab::Scene scene = hanging_cloth(s.method, 50.0, 0.001);
     clothlab::World& world = scene.world;
-    world.fast_path = s.fast;
+    if (!s.fast) world.backend.reset();
     world.threads = s.threads;
     for (int k = 0; k < 10; ++k)
       world.step(scene.dt);
@@ -179,7 +179,7 @@ TEST_CASE("guard: a blow-up stops the fast path's one pass as it stops the reada
       CAPTURE(extra);
       CAPTURE(method);
       clothlab::Scene readable = hanging_cloth(method, 4e5, 0.002, extra);
-      readable.world.fast_path = false;
+      readable.world.backend.reset();
       const Stop expected = run_until_stopped(readable, 2000);
       REQUIRE(expected.step > 0);
       for (int threads : {1, 2}) {

@@ -1,6 +1,6 @@
-// The fast path (fast_forces.hpp) against the readable one: the same numbers, bit for bit, on
-// any number of threads; the runs layout describes exactly the springs of a set, and keeps
-// doing so while tearing erases springs and plasticity changes rest lengths.
+// The fast engine (engine/fast/) against the lecture's path: the same numbers, bit for bit, on
+// any number of threads and any block size; the runs layout describes exactly the springs of a
+// set, and keeps doing so while tearing erases springs and plasticity changes rest lengths.
 #include <doctest/doctest.h>
 
 #include <algorithm>
@@ -22,6 +22,9 @@
 #include "clothlab/scene.hpp"
 #include "clothlab/spring_damper.hpp"
 #include "clothlab/threads.hpp"
+#include "fast/aerodynamics.hpp"
+#include "fast/engine.hpp"
+#include "fast/springs.hpp"
 #include "test_util.hpp"
 
 using clothlab::Index;
@@ -73,7 +76,7 @@ clothlab::Scene run(const std::string& text, bool fast, int threads, int steps,
                     const std::function<void(clothlab::World&)>& edit = {}) {
   clothlab::Scene scene = clothlab::parse_scene(text, "fast-path.toml");
   if (edit) edit(scene.world);
-  scene.world.fast_path = fast;
+  if (!fast) scene.world.backend.reset();
   scene.world.threads = threads;
   for (int s = 0; s < steps; ++s)
     scene.world.step(scene.dt);
@@ -83,6 +86,13 @@ clothlab::Scene run(const std::string& text, bool fast, int threads, int steps,
 // Bit for bit: == on doubles (no tolerance).
 bool identical(const Matrix3X& a, const Matrix3X& b) {
   return a.cols() == b.cols() && (a.array() == b.array()).all();
+}
+
+// The world's fast engine (a scene installs one unless it says fast_path = false).
+clothlab::fast::FastEngine& engine_of(const clothlab::World& world) {
+  auto* engine = dynamic_cast<clothlab::fast::FastEngine*>(world.backend.get());
+  REQUIRE(engine != nullptr);
+  return *engine;
 }
 
 clothlab::SpringDampers* spring_effect(clothlab::World& world, const char* name) {
@@ -102,9 +112,9 @@ TEST_CASE("fast path: runs cover every spring of a set once and in order") {
   clothlab::Scene scene = clothlab::parse_scene(cloth(""), "runs.toml");
   for (const char* name : {"springs", "bending"}) {
     const clothlab::SpringSet& s = spring_effect(scene.world, name)->springs();
-    const std::vector<clothlab::SpringRun> runs = clothlab::spring_runs(s);
+    const std::vector<clothlab::fast::SpringRun> runs = clothlab::fast::spring_runs(s);
     size_t k = 0;
-    for (const clothlab::SpringRun& run : runs) {
+    for (const clothlab::fast::SpringRun& run : runs) {
       REQUIRE(run.k0 == k);
       for (Index t = 0; t < run.length; ++t, ++k) {
         CHECK(s.i(k) == run.i0 + t);
@@ -157,20 +167,20 @@ TEST_CASE("fast path: every change of a spring set's ends or constants moves its
 TEST_CASE("fast path: a run is uniform while its springs share ks and kd") {
   clothlab::Scene scene = clothlab::parse_scene(cloth(""), "runs.toml");
   clothlab::SpringSet& s = spring_effect(scene.world, "springs")->springs();
-  std::vector<clothlab::SpringRun> runs = clothlab::spring_runs(s);
+  std::vector<clothlab::fast::SpringRun> runs = clothlab::fast::spring_runs(s);
   // Each family is added with one ks and one kd: every run is uniform.
   CHECK(std::all_of(runs.begin(), runs.end(), [](const auto& r) { return r.uniform; }));
   // One spring in the middle of the fifth run gets its own kd; that run alone is not uniform.
-  const clothlab::SpringRun fifth = runs[4];
+  const clothlab::fast::SpringRun fifth = runs[4];
   REQUIRE(fifth.length > 2);
   s.set_kd(fifth.k0 + 1, 2.0 * s.kd(fifth.k0));
   // The third run's kd all 0, one of them -0: equal by ==, not bit for bit, and not uniform (a
   // product with -0 can round to a zero of the other sign).
-  const clothlab::SpringRun third = runs[2];
+  const clothlab::fast::SpringRun third = runs[2];
   for (Index t = 0; t < third.length; ++t)
     s.set_kd(third.k0 + static_cast<size_t>(t), 0.0);
   s.set_kd(third.k0 + 1, -0.0);
-  runs = clothlab::spring_runs(s);
+  runs = clothlab::fast::spring_runs(s);
   for (size_t r = 0; r < runs.size(); ++r) {
     CAPTURE(r);
     CHECK(runs[r].uniform == (r != 4 && r != 2));
@@ -182,7 +192,7 @@ TEST_CASE("fast path: ks and kd changed in place between steps reach the forces"
   // of a run, or every spring of another) must reach the next step, as on the readable path.
   const auto edit = [](clothlab::World& w) {
     clothlab::SpringSet& s = clothlab::find_spring_effect(w, "springs")->springs();
-    const std::vector<clothlab::SpringRun> runs = clothlab::spring_runs(s);
+    const std::vector<clothlab::fast::SpringRun> runs = clothlab::fast::spring_runs(s);
     s.set_ks(runs[3].k0 + 5, 3.0 * s.ks(runs[3].k0 + 5));
     for (Index t = 0; t < runs.back().length; ++t)
       s.set_kd(runs.back().k0 + static_cast<size_t>(t), 0.5);
@@ -275,7 +285,7 @@ TEST_CASE("fast path: the builders' runs order keeps the same springs as the pai
   for (size_t k = 0; k < s.size(); ++k)
     CHECK(s.l0(k) == doctest::Approx((p.x.col(s.j(k)) - p.x.col(s.i(k))).norm()));
   // Rows first (direction +1), then columns (+cols): one run per row, one for all columns.
-  CHECK(clothlab::spring_runs(s).size() == static_cast<size_t>(rows + 1));
+  CHECK(clothlab::fast::spring_runs(s).size() == static_cast<size_t>(rows + 1));
 }
 
 TEST_CASE("fast path: the same state as the readable path, bit for bit, every integrator") {
@@ -338,10 +348,9 @@ TEST_CASE("fast path: effects without a fast path, between and after those with 
     const clothlab::Scene fast_scene = run(text, true, threads, 100, add_pull);
     const clothlab::World& readable = readable_scene.world;
     const clothlab::World& fast = fast_scene.world;
-    std::string soa;  // which effects have a fast path, in the world's order
-    for (const auto& e : fast.force_effects)
-      soa += std::string(e->name()) + (e->adds_soa(fast.particles) ? "+ " : "- ");
-    CHECK(soa == "springs+ pull- bending+ damping+ gravity+ aerodynamics+ drag+ buoyancy- ");
+    // Which effects the fast engine summed itself, in the world's order.
+    CHECK(engine_of(fast).plan() ==
+          "springs+ pull- bending+ damping+ gravity+ aerodynamics+ drag+ buoyancy-");
     CHECK(fast.fast_evaluations == fast.force_evaluations);
     CHECK(identical(fast.particles.x, readable.particles.x));
     CHECK(identical(fast.particles.v, readable.particles.v));
@@ -353,7 +362,7 @@ TEST_CASE("fast path: effects without a fast path, between and after those with 
 TEST_CASE("fast path: the Euler methods move particles in the pass that sums their forces") {
   // Without buoyancy the last effect has a fast path, so each thread copies its particles'
   // forces back and moves them, 512 at a time, in the pass that summed the forces
-  // (World::compute_forces_then). 45 x 41 cloth: ranges and chunks end mid-row.
+  // (FastEngine::step). 45 x 41 cloth: ranges and chunks end mid-row.
   for (const char* method : {"symplectic-euler", "explicit-euler"}) {
     for (int threads : {1, 2, 3}) {
       CAPTURE(method);
@@ -366,7 +375,7 @@ TEST_CASE("fast path: the Euler methods move particles in the pass that sums the
       const clothlab::Scene fast_scene = run(cloth("", method), true, threads, 30, no_buoyancy);
       const clothlab::World& readable = readable_scene.world;
       const clothlab::World& fast = fast_scene.world;
-      REQUIRE(fast.force_effects.back()->adds_soa(fast.particles));
+      REQUIRE(engine_of(fast).plan().ends_with("drag+"));
       CHECK(fast.fast_evaluations == fast.force_evaluations);
       CHECK(identical(fast.particles.x, readable.particles.x));
       CHECK(identical(fast.particles.v, readable.particles.v));
@@ -379,7 +388,7 @@ TEST_CASE("fast path: the Euler methods move particles in the pass that sums the
 
 TEST_CASE("fast path: blocks of any size give the readable state bit for bit") {
   // A step's one pass takes each thread's particles pass_block at a time through every effect,
-  // then moves them (fast_forces.cpp): springs across a block's border are evaluated on both
+  // then moves them (fast/engine.cpp): springs across a block's border are evaluated on both
   // sides. Blocks of one particle, shorter than a row, ending mid-row and mid-chunk, and larger
   // than the cloth; with a ground and a sphere riding along (the cloth starts through both).
   const std::string text = cloth("[sphere]\ncentre = [0.4, -0.45, 0.0]\nradius = 0.08\n");
@@ -394,9 +403,9 @@ TEST_CASE("fast path: blocks of any size give the readable state bit for bit") {
       CAPTURE(threads);
       const clothlab::Scene fast = run(text, true, threads, 40, [&](clothlab::World& w) {
         no_buoyancy(w);
-        w.pass_block = block;
+        engine_of(w).pass_block = block;
       });
-      REQUIRE(fast.world.force_effects.back()->adds_soa(fast.world.particles));
+      REQUIRE(engine_of(fast.world).plan().ends_with("drag+"));
       CHECK(fast.world.fast_evaluations == fast.world.force_evaluations);
       CHECK(identical(fast.world.particles.x, readable.world.particles.x));
       CHECK(identical(fast.world.particles.v, readable.world.particles.v));
@@ -423,8 +432,8 @@ TEST_CASE("fast path: 2, 3 and 4 threads give the 1-thread state bit for bit") {
 TEST_CASE("fast path: runs just below, at and above the gap where forces skip the buffer") {
   // A cloth `cols` wide has column springs cols particles apart, diagonals cols - 1 and
   // cols + 1, column bending 2 cols: around kDirectGap, the runs of one cloth take both ways
-  // (spring_damper.cpp), and a particle gets shares from both in one evaluation.
-  const Index gap = clothlab::SpringDampers::kDirectGap;
+  // (fast/springs.cpp), and a particle gets shares from both in one evaluation.
+  const Index gap = clothlab::fast::kDirectGap;
   for (Index cols : {gap - 1, gap, gap + 1}) {
     const std::string text = cloth("", "symplectic-euler", 12, cols);
     const clothlab::Scene readable = run(text, false, 1, 80);
@@ -465,7 +474,7 @@ TEST_CASE("fast path: a grid's triangles form one run per row, two triangles a c
       clothlab::parse_scene(cloth("", "symplectic-euler", rows, cols), "t");
   const auto* aero = test::find_force_effect<clothlab::Aerodynamics>(scene.world);
   REQUIRE(aero != nullptr);
-  const auto groups = clothlab::Aerodynamics::triangle_groups(aero->triangles());
+  const auto groups = clothlab::fast::triangle_groups(aero->triangles());
   REQUIRE(groups.size() == rows - 1);
   size_t next = 0;
   for (const auto& g : groups) {
@@ -511,7 +520,7 @@ TEST_CASE("fast path: triangles in other orders give the readable result") {
           effect =
               std::make_unique<clothlab::Aerodynamics>(t, clothlab::kAirDensity, 1.2, aero->wind());
         }
-        scene.world.fast_path = fast;
+        if (!fast) scene.world.backend.reset();
         scene.world.threads = threads;
         for (int step = 0; step < 60; ++step)
           scene.world.step(scene.dt);
@@ -528,7 +537,7 @@ TEST_CASE("fast path: a set changed in place, or with no runs, still gives the r
   const std::string text = cloth("", "symplectic-euler", 20, 20);
   clothlab::Scene fast = clothlab::parse_scene(text, "a.toml");
   clothlab::Scene readable = clothlab::parse_scene(text, "b.toml");
-  readable.world.fast_path = false;
+  readable.world.backend.reset();
   fast.world.threads = 2;
   // Shuffle the springs and flip every other one. The set forms no runs any more: the fast path
   // hands it to add_forces, which sums in the new order.
@@ -543,7 +552,7 @@ TEST_CASE("fast path: a set changed in place, or with no runs, still gives the r
     s = out;
     for (size_t k = 0; k < s.size(); k += 2)
       s.set_ends(k, s.j(k), s.i(k));
-    CHECK(clothlab::spring_runs(s).size() > s.size() / 2);
+    CHECK(clothlab::fast::spring_runs(s).size() > s.size() / 2);
   }
   for (int step = 0; step < 100; ++step) {
     fast.world.step(fast.dt);
@@ -558,13 +567,13 @@ TEST_CASE("fast path: springs listed from their higher-numbered end match the re
   const std::string text = cloth("", "symplectic-euler", 20, 20);
   clothlab::Scene fast = clothlab::parse_scene(text, "a.toml");
   clothlab::Scene readable = clothlab::parse_scene(text, "b.toml");
-  readable.world.fast_path = false;
+  readable.world.backend.reset();
   for (clothlab::World* w : {&fast.world, &readable.world}) {
     for (const char* name : {"springs", "bending"}) {
       clothlab::SpringSet& s = spring_effect(*w, name)->springs();
       for (size_t k = 0; k < s.size(); ++k)
         s.set_ends(k, s.j(k), s.i(k));
-      const std::vector<clothlab::SpringRun> runs = clothlab::spring_runs(s);
+      const std::vector<clothlab::fast::SpringRun> runs = clothlab::fast::spring_runs(s);
       CHECK(s.size() >= 8 * runs.size());
       CHECK(runs.front().i0 > runs.front().j0);
     }
@@ -580,38 +589,28 @@ TEST_CASE("fast path: springs listed from their higher-numbered end match the re
 
 namespace {
 
-// The scene stepped `steps` times the way `clothlab run --stats` steps it: every post-step
-// effect in a pass of its own after the integrator, the guard's checks in passes of their own.
+// The scene stepped `steps` times on the lecture's path alone: every post-step effect in a pass
+// of its own after the integrator, the guard's checks in passes of their own.
 clothlab::Scene run_in_separate_passes(const std::string& text, int steps,
                                        const std::function<void(clothlab::World&)>& edit = {}) {
   clothlab::Scene scene = clothlab::parse_scene(text, "fast-path.toml");
   if (edit) edit(scene.world);
-  clothlab::StepTimes times;
-  scene.world.timing = &times;
+  scene.world.backend.reset();
   for (int s = 0; s < steps; ++s)
     scene.world.step(scene.dt);
   return scene;
 }
 
 // A post-step effect that acts on each particle alone (a small push along x for any particle
-// below y = -0.3) and counts how the step calls it.
+// below y = -0.3), as a ground does, but one the fast engine does not know: it counts its calls.
 class PushLowParticles final : public clothlab::PostStepEffect {
  public:
-  mutable std::atomic<long> ranges{0}, wholes{0};
+  long wholes = 0;
   std::string_view name() const override { return "push"; }
   void apply(clothlab::World& world, double dt) override {
     ++wholes;
-    apply_one(world.particles, dt, 0, world.particles.size());
-  }
-  bool acts_per_particle() const override { return true; }
-  void apply_range(clothlab::Particles& p, double dt, Index begin, Index end) const override {
-    ++ranges;
-    apply_one(p, dt, begin, end);
-  }
-
- private:
-  static void apply_one(clothlab::Particles& p, double dt, Index begin, Index end) {
-    for (Index i = begin; i < end; ++i)
+    clothlab::Particles& p = world.particles;
+    for (Index i = 0; i < p.size(); ++i)
       if (p.x(1, i) < -0.3 && p.inv_m[i] > 0.0) p.v(0, i) += 0.5 * dt;
   }
 };
@@ -666,10 +665,10 @@ TEST_CASE(
 }
 
 TEST_CASE(
-    "fast path: only the post-step effects that act per particle and lead the list go "
-    "into the step's pass") {
-  // Per-particle effects at the front of the list are applied range by range in the pass
-  // (apply_range), never in a pass of their own (apply).
+    "fast path: only a ground and a sphere that lead the post-step list go into the step's "
+    "pass") {
+  // An effect the fast engine does not know is applied whole, after the pass, each step; the
+  // ground behind it waits for it, and the state is the lecture's path's.
   const std::string text = cloth("");
   for (int threads : {1, 2}) {
     CAPTURE(threads);
@@ -680,13 +679,26 @@ TEST_CASE(
       w.post_step_effects.insert(w.post_step_effects.begin(), std::move(effect));
     };
     const clothlab::Scene one_pass = run(text, true, threads, 40, push_first);
-    CHECK(push->wholes == 0);
-    CHECK(push->ranges >= 40);
+    CHECK(push->wholes == 40);
+    CHECK(one_pass.world.fast_evaluations == 40);
     const clothlab::Scene separate = run_in_separate_passes(text, 40, push_first);
     CHECK(push->wholes == 40);
-    CHECK(push->ranges == 0);
     CHECK(identical(one_pass.world.particles.x, separate.world.particles.x));
     CHECK(identical(one_pass.world.particles.v, separate.world.particles.v));
+  }
+  // The ground leading the list rides along: --stats finds no time of its own for it, where
+  // the lecture's path times its pass.
+  for (bool fast : {true, false}) {
+    CAPTURE(fast);
+    clothlab::Scene scene = clothlab::parse_scene(text, "fast-path.toml");
+    if (!fast) scene.world.backend.reset();
+    clothlab::StepTimes times;
+    scene.world.timing = &times;
+    for (int step = 0; step < 20; ++step)
+      scene.world.step(scene.dt);
+    REQUIRE(scene.world.post_step_effects.front()->name() == "ground");
+    CHECK((times.post_step_effects.front() == 0.0) == fast);
+    CHECK((times.backend_steps > 0.0) == fast);
   }
   // Behind an effect that reads the whole state, the ground waits until the step has moved
   // every particle and that effect has seen them: the lowest heights it records come from

@@ -1,0 +1,243 @@
+#include "fast/engine.hpp"
+
+#include <algorithm>
+#include <atomic>
+
+#include "clothlab/euler.hpp"
+#include "clothlab/ground_collision.hpp"
+#include "clothlab/world.hpp"
+
+namespace clothlab::fast {
+
+namespace {
+
+// Particles [begin, end) moved by their own forces with the one-particle kernel, on the engine's
+// layout: ExplicitEuler::advance's loop on a range. `flatten`: the kernel inlined at link time.
+template <class Kernel>
+[[gnu::flatten]] void move_particles(Particles& p, Index begin, Index end, double dt,
+                                     Kernel kernel) {
+  for (Index i = begin; i < end; ++i) {
+    const PointState next = kernel(p.x.col(i), p.v.col(i), p.f.col(i), p.inv_m[i], dt);
+    p.x.col(i) = next.r;
+    p.v.col(i) = next.v;
+  }
+}
+
+// The same moves, the kernel's inputs read from the copies, where component c of particle i
+// sits at x[c nx + i]: the compiler then takes several particles at once with vector
+// instructions, which the loop above, on x, y and z side by side, does not allow. The same
+// operations on the same values: the same bits. The pointers are declared not to overlap (the
+// outputs are the particles' own x and v, the inputs the copies), so the function is kept out
+// of line.
+template <class Kernel>
+[[gnu::noinline, gnu::flatten]] void move_particles_from_copies(
+    Index begin, Index end, double dt, Kernel kernel, const double* __restrict x, Index nx,
+    const double* __restrict v, Index nv, const double* __restrict f, Index nf,
+    const double* __restrict inv_m, double* __restrict x_out, double* __restrict v_out) {
+  for (Index i = begin; i < end; ++i) {
+    // Not const: GCC 12 does not split a const aggregate into its six doubles, and the loop
+    // then goes one particle at a time through the stack (three times slower).
+    PointState next =
+        kernel(Vec3(x[i], x[nx + i], x[2 * nx + i]), Vec3(v[i], v[nv + i], v[2 * nv + i]),
+               Vec3(f[i], f[nf + i], f[2 * nf + i]), inv_m[i], dt);
+    x_out[3 * i] = next.r.x();
+    x_out[3 * i + 1] = next.r.y();
+    x_out[3 * i + 2] = next.r.z();
+    v_out[3 * i] = next.v.x();
+    v_out[3 * i + 1] = next.v.y();
+    v_out[3 * i + 2] = next.v.z();
+  }
+}
+
+// An Euler method's move of particles [begin, end) (FastEngine::MoveRange), from the copies
+// when it has them. The kernels come wrapped in lambdas, each a type of its own, so that each
+// loop is compiled for its kernel, inlined.
+template <class Kernel>
+FastEngine::MoveRange euler_move(Particles& p, double dt, Kernel kernel) {
+  return [&p, dt, kernel](Index begin, Index end, const Copies* copies) {
+    if (!copies) {
+      move_particles(p, begin, end, dt, kernel);
+      return;
+    }
+    move_particles_from_copies(begin, end, dt, kernel, copies->x.data(), copies->x.cols(),
+                               copies->v.data(), copies->v.cols(), copies->f.data(),
+                               copies->f.cols(), p.inv_m.data(), p.x.data(), p.v.data());
+  };
+}
+
+}  // namespace
+
+bool FastEngine::prepare(const World& world) {
+  const auto& effects = world.force_effects;
+  forces_.resize(effects.size());
+  bool any = false;
+  for (size_t e = 0; e < effects.size(); ++e) {
+    Force& force = forces_[e];
+    if (force.effect != effects[e].get()) {
+      force.effect = effects[e].get();
+      force.fast = fast_force(*force.effect);
+    }
+    force.on = force.fast && force.fast->prepare(world.particles);
+    any = any || force.on;
+  }
+  return any;
+}
+
+std::string FastEngine::plan() const {
+  std::string names;
+  for (const Force& force : forces_) {
+    if (!names.empty()) names += ' ';
+    names += std::string(force.effect->name()) + (force.on ? "+" : "-");
+  }
+  return names;
+}
+
+bool FastEngine::sum_forces(const World& world, const Matrix3X& x, const Matrix3X& v, Matrix3X& f) {
+  if (!prepare(world)) return false;
+  pass(world, x, v, f);
+  return true;
+}
+
+BackendStep FastEngine::step(World& world, double dt) {
+  // Only the Euler methods move each particle by its own force alone, after one evaluation.
+  const Integrator* integrator = world.integrator.get();
+  const bool explicit_euler = dynamic_cast<const ExplicitEuler*>(integrator) != nullptr;
+  if (!explicit_euler && !dynamic_cast<const SymplecticEuler*>(integrator)) return {};
+  if (!prepare(world)) return {};
+  // The post-step effects that change each particle from its own state alone and lead the
+  // world's list ride along: each range meets them right after it moves, in the list's order,
+  // as it would in passes of their own. The others follow the step (World::step).
+  contacts_.clear();
+  for (const auto& effect : world.post_step_effects) {
+    if (const auto* ground = dynamic_cast<const Ground*>(effect.get())) {
+      contacts_.push_back({ground, nullptr});
+    } else if (const auto* sphere = dynamic_cast<const Sphere*>(effect.get())) {
+      contacts_.push_back({nullptr, sphere});
+    } else {
+      break;
+    }
+  }
+  Particles& p = world.particles;
+  const MoveRange move =
+      explicit_euler
+          ? euler_move(p, dt,
+                       [](const Vec3& r, const Vec3& v, const Vec3& f, double inv_m, double h) {
+                         return explicit_euler_step(r, v, f, inv_m, h);
+                       })
+          : euler_move(p, dt,
+                       [](const Vec3& r, const Vec3& v, const Vec3& f, double inv_m, double h) {
+                         return symplectic_euler_step(r, v, f, inv_m, h);
+                       });
+  MoveRange move_then_contacts;
+  const MoveRange* moves = &move;
+  if (!contacts_.empty()) {
+    move_then_contacts = [&](Index begin, Index end, const Copies* copies) {
+      move(begin, end, copies);
+      for (const Contact& contact : contacts_) {
+        if (contact.ground) contact.ground->collide(p, begin, end);
+        if (contact.sphere) contact.sphere->collide(p, begin, end);
+      }
+    };
+    moves = &move_then_contacts;
+  }
+  PassChecks checks;
+  checks.end = contacts_.size() == world.post_step_effects.size();
+  pass(world, p.x, p.v, p.f, moves, &checks);
+  ++world.force_evaluations;
+  ++world.fast_evaluations;
+  return {true, contacts_.size(), checks.end_checked && checks.end_within};
+}
+
+void FastEngine::pass(const World& world, const Matrix3X& x, const Matrix3X& v, Matrix3X& f,
+                      const MoveRange* move, PassChecks* checks) {
+  const auto& effects = world.force_effects;
+  const Index n = x.cols();
+  Copies& c = copies_;
+  c.resize(n);
+  f.resize(3, n);
+  std::atomic<bool> start_within = true;
+  world.for_particles([&](Index begin, Index end) {
+    if (!checks) {
+      to_soa(begin, end, x.data(), c.x.data(), c.x.cols());
+      to_soa(begin, end, v.data(), c.v.data(), c.v.cols());
+    } else {
+      const bool x_within =
+          to_soa_within(begin, end, x.data(), c.x.data(), c.x.cols(), world.guard.max_position);
+      const bool v_within =
+          to_soa_within(begin, end, v.data(), c.v.data(), c.v.cols(), world.guard.max_speed);
+      if (!x_within || !v_within) start_within = false;
+    }
+    c.f.middleCols(begin, end - begin).setZero();
+  });
+  // The step's state was bad before it began: the guard names the particle and throws, before
+  // anything moves.
+  if (!start_within) world.guard.check(world, /*before_step=*/true);
+  const auto move_f = [&](bool soa) {
+    world.for_particles([&](Index begin, Index end) {
+      if (soa) {
+        to_soa(begin, end, f.data(), c.f.data(), c.f.cols());
+      } else {
+        from_soa(begin, end, c.f.data(), c.f.cols(), f.data());
+      }
+    });
+  };
+  // The effects in the world's order; f moves to whichever layout the next effect works on.
+  // Consecutive effects with a fast form share one pass of the threads: each thread lets every
+  // one of them add its forces on the thread's own particles.
+  bool in_soa = true;
+  for (size_t e = 0; e < effects.size();) {
+    if (!forces_[e].on) {
+      if (in_soa) move_f(false);
+      in_soa = false;
+      effects[e]->add_forces(world.particles, x, v, f);
+      ++e;
+      continue;
+    }
+    size_t last = e + 1;
+    while (last < effects.size() && forces_[last].on)
+      ++last;
+    if (!in_soa) move_f(true);
+    in_soa = true;
+    const bool move_here = move && last == effects.size();
+    const bool check_end = move_here && checks && checks->end;
+    std::atomic<bool> end_within = true;
+    world.for_particles([&](Index begin, Index end) {
+      if (!move_here) {
+        for (size_t k = e; k < last; ++k)
+          forces_[k].fast->add(world.particles, c.x, c.v, c.f, begin, end);
+        return;
+      }
+      // Block by block (pass_block): every effect adds its forces on the block, then the block
+      // moves, while its x, v and f are still in the cache. These particles' forces are final:
+      // no other block or thread adds to them. The others read x and v from the copies, so
+      // moving these in x and v changes nothing they see.
+      const Particles& p = world.particles;
+      const Index block = std::max<Index>(pass_block, 1);
+      for (Index b0 = begin; b0 < end; b0 += block) {
+        const Index b1 = std::min(b0 + block, end);
+        for (size_t k = e; k < last; ++k)
+          forces_[k].fast->add(p, c.x, c.v, c.f, b0, b1);
+        for (Index c0 = b0; c0 < b1; c0 += kPassChunk) {
+          const Index c1 = std::min(c0 + kPassChunk, b1);
+          from_soa(c0, c1, c.f.data(), c.f.cols(), f.data());
+          (*move)(c0, c1, &c);
+          if (check_end && !world.guard.within(p.x, p.v, c0, c1)) end_within = false;
+        }
+      }
+    });
+    if (check_end) {
+      checks->end_checked = true;
+      checks->end_within = end_within;
+    }
+    if (move_here) return;
+    e = last;
+  }
+  if (in_soa) move_f(false);
+  if (move) world.for_particles([&](Index begin, Index end) { (*move)(begin, end, nullptr); });
+}
+
+std::unique_ptr<Backend> make_fast_engine() {
+  return std::make_unique<FastEngine>();
+}
+
+}  // namespace clothlab::fast

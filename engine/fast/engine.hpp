@@ -1,0 +1,114 @@
+// engine.hpp: the fast engine, the world's backend (clothlab/backend.hpp) unless a scene says
+// `[engine] fast_path = false`.
+//
+// World::compute_forces_readable is the lecture's loop: clear every force, then let each effect
+// add its forces, particle by particle or spring by spring, on the engine's own layout (one
+// column x, y, z per particle). It is what the lessons show. The fast engine computes the same
+// sums on another layout (copies.hpp):
+//
+//   1. copy x and v into the copies (all x components, then all y, then all z) and clear f there;
+//   2. every effect it knows (forces.hpp) adds its forces there: a loop over particles, or over
+//      a run of springs (springs.hpp), reads each component in memory order, so the compiler
+//      computes four springs at once with vector instructions, through the same exercise
+//      kernels. With threads, each takes a contiguous range of particles and every effect adds
+//      the forces on that range only: no two threads write the same force;
+//   3. copy f back.
+//
+// A step of an Euler method (each particle moves by its own force alone) goes further: each
+// particle moves right there, in the pass that summed its force, reading its state from the
+// copies. That pass takes each thread's particles a block at a time (pass_block): every effect
+// adds its forces on the block, then the block moves. The pass also checks each particle for the
+// guard as it copies it and after it moves, and the ground and the sphere, when they lead the
+// world's post-step effects, push each particle out right after it moves: the same checks and
+// the same contacts, without passes of their own over the whole state.
+//
+// Each particle receives the same floating-point operations in the same order as on the
+// lecture's path, so the two agree bit for bit, with any number of threads and any block size
+// (tests/fast/). An effect the engine does not know (buoyancy, gravitation) adds its forces with
+// add_forces, on the engine's layout, in its turn: f is copied across when the layout changes.
+// SPEED.md has the measurements behind each choice.
+#pragma once
+
+#include <functional>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "clothlab/backend.hpp"
+#include "fast/copies.hpp"
+#include "fast/forces.hpp"
+
+namespace clothlab {
+class Ground;
+class Sphere;
+}  // namespace clothlab
+
+namespace clothlab::fast {
+
+// Particles a thread copies, checks or moves at once: their x, v and f in the engine's layout
+// (36 KiB) stay in the second-level cache from one of these to the next.
+inline constexpr Index kPassChunk = 512;
+
+// Particles a thread takes through every force effect and then moves, in a step's one pass
+// (FastEngine::pass_block): their x, v and f in the fast layout (72 bytes a particle, 576 KiB)
+// stay in the second-level cache from one effect to the next, where a whole cloth would stream
+// through it once per effect. A spring with an end on each side of a border is evaluated on
+// both sides, each adding only to its own end: for a grid, about 1 / R more springs, R = rows
+// per block (32 for a 256-wide cloth). SPEED.md has the measurements behind the size.
+inline constexpr Index kPassBlock = 8192;
+
+class FastEngine final : public Backend {
+ public:
+  // Particles a thread sums and moves at once in a step's one pass (kPassBlock). Any value
+  // gives the same bits; it sets only how much of the cloth each pass keeps in the cache.
+  Index pass_block = kPassBlock;
+
+  bool sum_forces(const World& world, const Matrix3X& x, const Matrix3X& v, Matrix3X& f) override;
+  BackendStep step(World& world, double dt) override;
+
+  // Which of the world's force effects it summed itself in its last evaluation ("gravity+
+  // springs+ buoyancy-"), for tests and for `clothlab bench`.
+  std::string plan() const;
+
+  // An update of particles [begin, end) after their forces are summed: it may read f and change
+  // the state of those particles only. With `copies`, the copies hold, for those particles, the
+  // same x, v and f as the engine's layout, bit for bit, and the update may read them instead.
+  using MoveRange = std::function<void(Index begin, Index end, const Copies* copies)>;
+
+ private:
+  // The guard's checks a step's one pass takes on (step).
+  struct PassChecks {
+    bool end = false;          // check the state after the move too
+    bool end_checked = false;  // the pass checked every particle after moving it,
+    bool end_within = false;   // and found them all within the guard's bounds
+  };
+
+  // Matches forces_ to the world's force effects and asks each fast form whether it takes this
+  // evaluation. Whether any does.
+  bool prepare(const World& world);
+  // The forces at (x, v) into f; then, with `move`, move on ranges that cover every particle
+  // once: where the last effect has a fast form, each thread calls it on its own particles,
+  // kPassChunk at a time, right after copying their forces back. With `checks`, (x, v) is the
+  // state a step starts from: it is checked as it is copied (a bad one throws the guard's error
+  // before any particle moves), and the new state as it is moved if checks->end.
+  void pass(const World& world, const Matrix3X& x, const Matrix3X& v, Matrix3X& f,
+            const MoveRange* move = nullptr, PassChecks* checks = nullptr);
+
+  struct Force {
+    const ForceEffect* effect = nullptr;  // the world's effect at this place
+    std::unique_ptr<FastForce> fast;      // its fast form, or null
+    bool on = false;                      // it takes the current evaluation
+  };
+  std::vector<Force> forces_;
+  struct Contact {  // a leading post-step effect that rides along in a step's pass
+    const Ground* ground = nullptr;
+    const Sphere* sphere = nullptr;
+  };
+  std::vector<Contact> contacts_;
+  Copies copies_;
+};
+
+// A world's fast engine: what a scene installs as World::backend.
+std::unique_ptr<Backend> make_fast_engine();
+
+}  // namespace clothlab::fast

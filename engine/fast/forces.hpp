@@ -1,0 +1,46 @@
+// forces.hpp: the force effects the fast engine can sum on its copies (copies.hpp).
+//
+// The fast engine recognises an effect by its type and reads what it needs through the effect's
+// public accessors: the effects themselves (engine/clothlab/) know nothing of it. For each one it
+// keeps a FastForce, which adds the same forces as the effect's add_forces, on a range of
+// particles, with the same floating-point operations on each particle in the same order, so
+// that the two paths agree bit for bit. An effect it does not recognise (buoyancy, gravitation,
+// one a student wrote) adds its forces with add_forces, in its turn (engine.cpp).
+#pragma once
+
+#include <memory>
+
+#include "clothlab/effect.hpp"
+#include "fast/copies.hpp"
+
+namespace clothlab {
+class SpringDampers;
+class Aerodynamics;
+}  // namespace clothlab
+
+namespace clothlab::fast {
+
+class FastForce {
+ public:
+  virtual ~FastForce() = default;
+
+  // Whether it takes this evaluation; called once per evaluation, on one thread, so it may
+  // rebuild what it keeps of its effect (a layout of springs or triangles) when that changed.
+  virtual bool prepare(const Particles& p) = 0;
+
+  // The effect's forces on particles [begin, end) only, added into those columns of f. It reads
+  // x and v anywhere (a spring reaches out of the range) and writes f nowhere else: different
+  // threads take different ranges at once.
+  virtual void add(const Particles& p, const SoA3& x, const SoA3& v, SoA3& f, Index begin,
+                   Index end) const = 0;
+};
+
+// The fast form of `effect`, reading it where it is (it must outlive the result), or null when
+// there is none.
+std::unique_ptr<FastForce> fast_force(const ForceEffect& effect);
+
+// The ones with files of their own (springs.cpp, aerodynamics.cpp).
+std::unique_ptr<FastForce> fast_springs(const SpringDampers& springs);
+std::unique_ptr<FastForce> fast_aerodynamics(const Aerodynamics& aerodynamics);
+
+}  // namespace clothlab::fast

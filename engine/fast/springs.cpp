@@ -1,0 +1,340 @@
+// springs.cpp: the fast engine's spring-dampers (SpringDampers), run by run.
+//
+// SpringDampers::add_forces is the lecture's loop: for each spring, f1 from the exercise kernel,
+// added to one end and subtracted from the other. It reads i[k] and j[k] and jumps to wherever they
+// point, so the compiler must take one spring at a time. The fast path computes the same f1 with
+// the same kernel, but run by run (see SpringRun): along a run both ends move one particle at a
+// time, and in the structure-of-arrays layout every input of spring t + 1 sits just after that
+// of spring t. The compiler then evaluates the kernel (inlined at link time) on four springs at
+// once (eight with AVX-512). A uniform run (SpringRun::uniform, a family added with one ks and
+// one kd) passes its first spring's ks and kd to every spring, so each spring reads one constant
+// from memory instead of three (SPEED.md measures what that saves on a large cloth). A run
+// is taken in chunks of kChunk springs:
+//
+//   1. f1 of the chunk's springs into a small buffer (it stays in the processor's nearest cache);
+//   2. the chunk's upper ends (the higher particle numbers) take their shares, then its lower
+//      ends: f += f1 on the i side, f -= f1 on the j side, as in add_forces.
+//
+// Bit for bit the same sums: a particle collects its springs in the order add_forces adds them.
+// Across runs that is run order. Within a run from particles L0 + t to U0 + t (L0 < U0), a
+// particle p is the upper end of spring p - U0 and the lower end of spring p - L0, which comes
+// later: in a later chunk, or in the same chunk, where upper ends go first.
+//
+// Runs whose ends lie kDirectGap or more particles apart (a grid's columns and diagonals) need no
+// buffer: each spring's f1 goes straight to both ends (run_kernel_direct below says why the
+// order of the sums stays the same).
+//
+// With several threads, each owns a contiguous range of particles and adds only to those: it
+// takes every spring with an end in its range. A spring between two ranges is computed by both
+// threads (the same bits twice); nothing is shared, so there are no locks and no atomics.
+
+#include "fast/springs.hpp"
+
+#include <algorithm>
+#include <bit>
+#include <cstdint>
+
+#include "fast/forces.hpp"
+
+namespace clothlab::fast {
+namespace {
+
+// The same double, bit for bit: -0.0 and 0.0 differ here, which == would not see, and the fast
+// path must compute a uniform run's springs with their own bits.
+bool same_bits(double a, double b) {
+  return std::bit_cast<std::uint64_t>(a) == std::bit_cast<std::uint64_t>(b);
+}
+
+}  // namespace
+
+std::vector<SpringRun> spring_runs(const SpringSet& s) {
+  std::vector<SpringRun> runs;
+  for (size_t k = 0; k < s.size(); ++k) {
+    // Spring k continues the last run if it joins the particles just after its last spring's.
+    if (!runs.empty()) {
+      SpringRun& last = runs.back();
+      if (s.i(k) == last.i0 + last.length && s.j(k) == last.j0 + last.length) {
+        last.uniform =
+            last.uniform && same_bits(s.ks(k), s.ks(last.k0)) && same_bits(s.kd(k), s.kd(last.k0));
+        ++last.length;
+        continue;
+      }
+    }
+    runs.push_back({k, s.i(k), s.j(k), 1, true});
+  }
+  return runs;
+}
+
+namespace {
+
+// A function of its own, not inlined, so that every pointer can be declared not to overlap the
+// others: then the compiler vectorises the loop, kernel inlined. With Uniform, ks[0] and kd[0]
+// serve every spring: read once, outside the loop, instead of two more numbers per spring.
+template <bool Uniform>
+[[gnu::noinline]] void forces_of_run(Index count, Index nx, Index nv, const double* __restrict x1,
+                                     const double* __restrict x2, const double* __restrict v1,
+                                     const double* __restrict v2, const double* __restrict ks,
+                                     const double* __restrict kd, const double* __restrict l0,
+                                     double* __restrict f1x, double* __restrict f1y,
+                                     double* __restrict f1z) {
+  for (Index t = 0; t < count; ++t) {
+    const Vec3 f1 = spring_damper_force(
+        Vec3(x1[t], x1[nx + t], x1[2 * nx + t]), Vec3(x2[t], x2[nx + t], x2[2 * nx + t]),
+        Vec3(v1[t], v1[nv + t], v1[2 * nv + t]), Vec3(v2[t], v2[nv + t], v2[2 * nv + t]),
+        ks[Uniform ? 0 : t], kd[Uniform ? 0 : t], l0[t]);
+    f1x[t] = f1.x();
+    f1y[t] = f1.y();
+    f1z[t] = f1.z();
+  }
+}
+
+}  // namespace
+
+void spring_forces_of_run(Index count, Index nx, Index nv, const double* x1, const double* x2,
+                          const double* v1, const double* v2, const double* ks, const double* kd,
+                          const double* l0, double* f1x, double* f1y, double* f1z, bool uniform) {
+  (uniform ? forces_of_run<true> : forces_of_run<false>)(count, nx, nv, x1, x2, v1, v2, ks, kd, l0,
+                                                         f1x, f1y, f1z);
+}
+
+namespace {
+
+constexpr Index kChunk = 256;  // springs per chunk: f1 of a chunk takes 6 KiB
+
+// Runs whose two ends are at least kDirectGap particles apart (a grid's column, diagonal and
+// column-bending springs) skip the buffer: each spring's f1 goes straight to both its ends.
+// Spring t writes the forces on particles lower + t and upper + t = lower + t + gap; a particle
+// that is the upper end of spring t is the lower end of spring t + gap. The compiler is told
+// that the loop's passes are independent: true as long as it takes fewer than gap springs at
+// once, and it takes 4 (AVX2) or 8 (AVX-512). Each particle then gets its two shares in separate
+// passes, upper first, as on the readable path, and nothing is stored only to be read back.
+// (kDirectGap; FastSprings::add_run takes this path for such runs.)
+
+// Springs t = 0 .. count - 1 of a run (inputs as in forces_of_run), their forces added to
+// the upper ends (f_upper[c n + t], if ToUpper) and the lower ends (f_lower[c n + t], if ToLower):
+// +f1 to the i end and -f1 to the j end. f_upper and f_lower point into the same array,
+// kDirectGap or more apart, which is why they are not restrict. `flatten` asks for the kernel
+// inlined at link time, as in forces_of_run: for these twelve instances GCC declines otherwise.
+template <bool Uniform, bool UpperIsJ, bool ToUpper, bool ToLower>
+[[gnu::noinline, gnu::flatten]] void run_kernel_direct(
+    Index count, Index nx, Index nv, Index n, const double* __restrict x1,
+    const double* __restrict x2, const double* __restrict v1, const double* __restrict v2,
+    const double* __restrict ks, const double* __restrict kd, const double* __restrict l0,
+    double* f_upper, double* f_lower) {
+  // No two springs the compiler takes at once touch the same particle (see kDirectGap). Clang
+  // says so when it cannot vectorise the loop anyway, which is the case whenever the kernel is
+  // not inlined (a build without link-time optimisation): no reason for a warning.
+#if defined(__clang__)
+#pragma clang diagnostic push
+#pragma clang diagnostic ignored "-Wpass-failed"
+#pragma clang loop vectorize(assume_safety)
+#elif defined(__GNUC__)
+#pragma GCC ivdep
+#endif
+  for (Index t = 0; t < count; ++t) {
+    const Vec3 f1 = spring_damper_force(
+        Vec3(x1[t], x1[nx + t], x1[2 * nx + t]), Vec3(x2[t], x2[nx + t], x2[2 * nx + t]),
+        Vec3(v1[t], v1[nv + t], v1[2 * nv + t]), Vec3(v2[t], v2[nv + t], v2[2 * nv + t]),
+        ks[Uniform ? 0 : t], kd[Uniform ? 0 : t], l0[t]);
+    // The i end gets +f1, the j end -f1. Component by component, written out: the compiler
+    // keeps f1 in registers only if no loop index picks its components.
+    double* const f_i = UpperIsJ ? f_lower : f_upper;
+    double* const f_j = UpperIsJ ? f_upper : f_lower;
+    if constexpr (UpperIsJ ? ToLower : ToUpper) {
+      f_i[t] += f1.x();
+      f_i[n + t] += f1.y();
+      f_i[2 * n + t] += f1.z();
+    }
+    if constexpr (UpperIsJ ? ToUpper : ToLower) {
+      f_j[t] -= f1.x();
+      f_j[n + t] -= f1.y();
+      f_j[2 * n + t] -= f1.z();
+    }
+  }
+#if defined(__clang__)
+#pragma clang diagnostic pop
+#endif
+}
+
+// f[c][t] += f1[c][t] (add) or -= (subtract), for t = 0 .. count - 1 and each component c;
+// f's components are n apart, f1's kChunk apart.
+void add_shares(Index count, Index n, const double* __restrict f1, double* __restrict f, bool add) {
+  for (int c = 0; c < 3; ++c) {
+    double* __restrict fc = f + c * n;
+    const double* __restrict f1c = f1 + c * kChunk;
+    if (add) {
+      for (Index t = 0; t < count; ++t)
+        fc[t] += f1c[t];
+    } else {
+      for (Index t = 0; t < count; ++t)
+        fc[t] -= f1c[t];
+    }
+  }
+}
+
+// A particle that is the upper end of spring t and the lower end of spring t + gap of the same
+// chunk takes both shares in one visit, upper first: f[c][t] = (f[c][t] -+ f1[c][t]) +- f1[c][t +
+// gap], for t = 0 .. count - 1 (- then + when the upper ends are the j ends). Two passes would
+// read back, one to three places over, a value just stored by a vector instruction, which the
+// processor cannot forward from its store buffer: a stall on every load.
+void add_both_shares(Index count, Index n, Index gap, const double* __restrict f1,
+                     double* __restrict f, bool upper_is_j) {
+  for (int c = 0; c < 3; ++c) {
+    double* __restrict fc = f + c * n;
+    const double* __restrict up = f1 + c * kChunk;
+    const double* __restrict lo = up + gap;
+    if (upper_is_j) {
+      for (Index t = 0; t < count; ++t)
+        fc[t] = (fc[t] - up[t]) + lo[t];
+    } else {
+      for (Index t = 0; t < count; ++t)
+        fc[t] = (fc[t] + up[t]) - lo[t];
+    }
+  }
+}
+
+}  // namespace
+
+namespace {
+
+// SpringDampers::add_forces on the copies, run by run. The runs are cut again whenever the set's
+// ends or constants change (SpringSet::version), checked before every evaluation.
+class FastSprings final : public FastForce {
+ public:
+  explicit FastSprings(const SpringDampers& springs) : springs_(springs) {}
+
+  bool prepare(const Particles& /*p*/) override {
+    const SpringSet& s = springs_.springs();
+    if (!built_ || version_ != s.version()) {
+      runs_ = spring_runs(s);
+      version_ = s.version();
+      built_ = true;
+    }
+    // Runs of a few springs cost more in bookkeeping than they save: such a set (springs given
+    // one by one, or shuffled) is left to add_forces.
+    constexpr size_t kMinMeanRun = 8;
+    return s.size() >= kMinMeanRun * runs_.size();
+  }
+
+  void add(const Particles& /*p*/, const SoA3& x, const SoA3& v, SoA3& f, Index begin,
+           Index end) const override {
+    for (const SpringRun& run : runs_)
+      add_run(run, begin, end, x, v, f);
+  }
+
+ private:
+  // Adds the forces of the springs of `run` on the particles [p_begin, p_end) to f.
+  void add_run(const SpringRun& run, Index p_begin, Index p_end, const SoA3& x, const SoA3& v,
+               SoA3& f) const;
+  // The same for a run whose ends are kDirectGap or more apart, without the buffer: springs
+  // [up_begin, up_end) have their upper end in range, [lo_begin, lo_end) their lower end.
+  void add_run_direct(const SpringRun& run, Index up_begin, Index up_end, Index lo_begin,
+                      Index lo_end, const SoA3& x, const SoA3& v, SoA3& f) const;
+
+  const SpringDampers& springs_;
+  std::vector<SpringRun> runs_;
+  bool built_ = false;
+  unsigned long version_ = 0;
+};
+
+void FastSprings::add_run(const SpringRun& run, Index p_begin, Index p_end, const SoA3& x,
+                          const SoA3& v, SoA3& f) const {
+  const Index n = f.cols();  // the stride of f's rows (of x's: x.cols(), of v's: v.cols())
+  const Index lower = std::min(run.i0, run.j0), upper = std::max(run.i0, run.j0);
+  const auto in_run = [&](Index t) { return std::clamp<Index>(t, 0, run.length); };
+  // The springs with an upper end in [p_begin, p_end), and those with a lower end there.
+  const Index up_begin = in_run(p_begin - upper), up_end = in_run(p_end - upper);
+  const Index lo_begin = in_run(p_begin - lower), lo_end = in_run(p_end - lower);
+  if (up_begin == up_end && lo_begin == lo_end) return;
+  if (upper - lower >= kDirectGap) {
+    add_run_direct(run, up_begin, up_end, lo_begin, lo_end, x, v, f);
+    return;
+  }
+  const Index first = up_begin < up_end ? up_begin : lo_begin;
+  const Index last = lo_begin < lo_end ? lo_end : up_end;
+  const bool upper_is_j = run.j0 > run.i0;
+  double f1[3 * kChunk];
+  for (Index c0 = first; c0 < last; c0 += kChunk) {
+    const Index c1 = std::min(c0 + kChunk, last);
+    const Index k = static_cast<Index>(run.k0) + c0;
+    spring_forces_of_run(c1 - c0, x.cols(), v.cols(), x.data() + run.i0 + c0,
+                         x.data() + run.j0 + c0, v.data() + run.i0 + c0, v.data() + run.j0 + c0,
+                         springs_.springs().ks().data() + k, springs_.springs().kd().data() + k,
+                         springs_.springs().l0().data() + k, f1, f1 + kChunk, f1 + 2 * kChunk,
+                         run.uniform);
+    // Springs [u0, u1) of the chunk give upper ends their shares, [l0, l1) lower ends theirs.
+    // Upper end upper + t is lower end lower + t + gap: where both fall in this chunk, that
+    // particle takes both at once (upper first); the others take theirs one pass at a time.
+    const Index gap = upper - lower;
+    const Index u0 = std::max(c0, up_begin), u1 = std::min(c1, up_end);
+    const Index l0 = std::max(c0, lo_begin), l1 = std::min(c1, lo_end);
+    const Index both0 = std::max(u0, l0 - gap), both1 = std::max(both0, std::min(u1, l1 - gap));
+    double* const f_upper = f.data() + upper;
+    double* const f_lower = f.data() + lower;
+    const auto upper_only = [&](Index t0, Index t1) {
+      if (t0 < t1) add_shares(t1 - t0, n, f1 + (t0 - c0), f_upper + t0, !upper_is_j);
+    };
+    const auto lower_only = [&](Index t0, Index t1) {
+      if (t0 < t1) add_shares(t1 - t0, n, f1 + (t0 - c0), f_lower + t0, upper_is_j);
+    };
+    if (both0 == both1) {
+      upper_only(u0, u1);
+      lower_only(l0, l1);
+      continue;
+    }
+    // Distinct particles in each of the three: upper shares whose lower partner is in another
+    // chunk, the particles with both, lower shares whose upper partner came in an earlier one.
+    upper_only(u0, both0);
+    upper_only(both1, u1);
+    add_both_shares(both1 - both0, n, gap, f1 + (both0 - c0), f_upper + both0, upper_is_j);
+    lower_only(l0, both0 + gap);
+    lower_only(both1 + gap, l1);
+  }
+}
+
+void FastSprings::add_run_direct(const SpringRun& run, Index up_begin, Index up_end, Index lo_begin,
+                                 Index lo_end, const SoA3& x, const SoA3& v, SoA3& f) const {
+  const Index lower = std::min(run.i0, run.j0), upper = std::max(run.i0, run.j0);
+  const bool upper_is_j = run.j0 > run.i0;
+  // Springs [t0, t1) of the run, their forces added to the ends that are in range.
+  const auto springs = [&](Index t0, Index t1, bool to_upper, bool to_lower) {
+    if (t0 >= t1) return;
+    const Index k = static_cast<Index>(run.k0) + t0;
+    // run_kernel_direct<Uniform, UpperIsJ, ToUpper, ToLower> by
+    // [uniform][upper_is_j][to_upper][to_lower].
+    using Kernel = decltype(&run_kernel_direct<false, false, true, true>);
+    static constexpr Kernel kernels[2][2][2][2] = {
+        {{{nullptr, run_kernel_direct<false, false, false, true>},
+          {run_kernel_direct<false, false, true, false>,
+           run_kernel_direct<false, false, true, true>}},
+         {{nullptr, run_kernel_direct<false, true, false, true>},
+          {run_kernel_direct<false, true, true, false>,
+           run_kernel_direct<false, true, true, true>}}},
+        {{{nullptr, run_kernel_direct<true, false, false, true>},
+          {run_kernel_direct<true, false, true, false>,
+           run_kernel_direct<true, false, true, true>}},
+         {{nullptr, run_kernel_direct<true, true, false, true>},
+          {run_kernel_direct<true, true, true, false>,
+           run_kernel_direct<true, true, true, true>}}}};
+    kernels[run.uniform][upper_is_j][to_upper][to_lower](
+        t1 - t0, x.cols(), v.cols(), f.cols(), x.data() + run.i0 + t0, x.data() + run.j0 + t0,
+        v.data() + run.i0 + t0, v.data() + run.j0 + t0, springs_.springs().ks().data() + k,
+        springs_.springs().kd().data() + k, springs_.springs().l0().data() + k,
+        f.data() + upper + t0, f.data() + lower + t0);
+  };
+  // Spring t has its upper end in range for t in [up_begin, up_end) and its lower end for t in
+  // [lo_begin, lo_end), the same interval shifted by the gap (or clamped to the run). In the
+  // order of t: springs with only their upper end in range, then both, then only the lower.
+  const Index both_begin = std::max(up_begin, lo_begin), both_end = std::min(up_end, lo_end);
+  springs(up_begin, std::min(up_end, lo_begin), true, false);
+  springs(both_begin, both_end, true, true);
+  springs(std::max(up_end, lo_begin), lo_end, false, true);
+}
+
+}  // namespace
+
+std::unique_ptr<FastForce> fast_springs(const SpringDampers& springs) {
+  return std::make_unique<FastSprings>(springs);
+}
+
+}  // namespace clothlab::fast
