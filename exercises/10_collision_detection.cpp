@@ -11,9 +11,9 @@
 #include <cmath>
 #include <cstdint>
 
-#include "clothlab/not_implemented.hpp"
-#include "clothlab/self_collision.hpp"
-#include "clothlab/spatial_hash.hpp"
+#include "clothlab/after_step/self_collision.hpp"
+#include "clothlab/after_step/spatial_hash.hpp"
+#include "clothlab/core/not_implemented.hpp"
 
 namespace clothlab {
 

@@ -11,8 +11,8 @@
 #include <algorithm>
 #include <cmath>
 
-#include "clothlab/game_loop.hpp"
-#include "clothlab/not_implemented.hpp"
+#include "clothlab/core/game_loop.hpp"
+#include "clothlab/core/not_implemented.hpp"
 
 namespace clothlab {
 

@@ -8,10 +8,10 @@
 // Every symbol is explained in lessons/01-particles-and-euler/README.md.
 // Nothing needs rebuilding by hand: the grader, and each student program before it runs,
 // compiles what you saved first.
-#include "clothlab/euler.hpp"
-#include "clothlab/gravitation.hpp"
-#include "clothlab/gravity.hpp"
-#include "clothlab/not_implemented.hpp"
+#include "clothlab/core/not_implemented.hpp"
+#include "clothlab/forces/gravitation.hpp"
+#include "clothlab/forces/gravity.hpp"
+#include "clothlab/integrators/euler.hpp"
 
 namespace clothlab {
 

@@ -8,8 +8,8 @@
 // Every symbol is explained in lessons/02-spring-dampers/README.md.
 // Nothing needs rebuilding by hand: the grader, and each student program before it runs,
 // compiles what you saved first.
-#include "clothlab/not_implemented.hpp"
-#include "clothlab/spring_damper.hpp"
+#include "clothlab/core/not_implemented.hpp"
+#include "clothlab/forces/spring_damper.hpp"
 
 namespace clothlab {
 

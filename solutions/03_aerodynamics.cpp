@@ -8,8 +8,8 @@
 // Every symbol is explained in lessons/03-aerodynamics/README.md.
 // Nothing needs rebuilding by hand: the grader, and each student program before it runs,
 // compiles what you saved first.
-#include "clothlab/aerodynamics.hpp"
-#include "clothlab/not_implemented.hpp"
+#include "clothlab/core/not_implemented.hpp"
+#include "clothlab/forces/aerodynamics.hpp"
 
 namespace clothlab {
 

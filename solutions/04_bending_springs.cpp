@@ -8,15 +8,15 @@
 // Every symbol is explained in lessons/04-bending-springs/README.md.
 // Nothing needs rebuilding by hand: the grader, and each student program before it runs,
 // compiles what you saved first.
-#include "clothlab/cloth.hpp"
-#include "clothlab/not_implemented.hpp"
+#include "clothlab/bodies/cloth.hpp"
+#include "clothlab/core/not_implemented.hpp"
 
 namespace clothlab {
 
 // Exercise ex04.1: the bending pairs of a rows x cols grid, as grid-local indices r * cols + c:
 // (r,c)-(r,c+2) along every row and (r,c)-(r+2,c) down every column.
 // Hints:
-//   1. Look at structural_pairs() in engine/clothlab/cloth.cpp: the same loops, two apart.
+//   1. Look at structural_pairs() in engine/clothlab/bodies/cloth.cpp: the same loops, two apart.
 //   2. How many? rows * (cols - 2) along the rows plus cols * (rows - 2) down the columns, and
 //      none along a side with fewer than 3 particles.
 //   3. Each pair once: (a, b) and (b, a) would be two springs on the same two particles.

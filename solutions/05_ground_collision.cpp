@@ -8,8 +8,8 @@
 // Every symbol is explained in lessons/05-ground-collision/README.md.
 // Nothing needs rebuilding by hand: the grader, and each student program before it runs,
 // compiles what you saved first.
-#include "clothlab/ground_collision.hpp"
-#include "clothlab/not_implemented.hpp"
+#include "clothlab/after_step/ground_collision.hpp"
+#include "clothlab/core/not_implemented.hpp"
 
 namespace clothlab {
 

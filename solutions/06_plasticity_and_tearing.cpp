@@ -11,9 +11,9 @@
 #include <algorithm>
 #include <cmath>
 
-#include "clothlab/not_implemented.hpp"
-#include "clothlab/plasticity.hpp"
-#include "clothlab/tearing.hpp"
+#include "clothlab/after_step/plasticity.hpp"
+#include "clothlab/after_step/tearing.hpp"
+#include "clothlab/core/not_implemented.hpp"
 
 namespace clothlab {
 

@@ -8,8 +8,8 @@
 // Every symbol is explained in lessons/07-integrators/README.md.
 // Nothing needs rebuilding by hand: the grader, and each student program before it runs,
 // compiles what you saved first.
-#include "clothlab/not_implemented.hpp"
-#include "clothlab/runge_kutta.hpp"
+#include "clothlab/core/not_implemented.hpp"
+#include "clothlab/integrators/runge_kutta.hpp"
 
 namespace clothlab {
 

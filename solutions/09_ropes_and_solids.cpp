@@ -10,8 +10,8 @@
 // compiles what you saved first.
 #include <cmath>
 
-#include "clothlab/not_implemented.hpp"
-#include "clothlab/strain_limiting.hpp"
+#include "clothlab/after_step/strain_limiting.hpp"
+#include "clothlab/core/not_implemented.hpp"
 
 namespace clothlab {
 

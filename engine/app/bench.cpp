@@ -9,7 +9,7 @@
 // the same passes with the kernels' arithmetic written inline here, in one run, and prints the
 // ratio: close to 1 means the boundary costs nothing.
 //
-// bench accuracy: the work-precision study of lesson 07 (clothlab/accuracy.hpp): every
+// bench accuracy: the work-precision study of lesson 07 (analysis/accuracy.hpp): every
 // integrator over a ladder of time steps, printed as a table, written as CSV and drawn as a
 // log-log plot by a small matplotlib script written next to the CSV.
 #include "app/bench.hpp"
@@ -26,15 +26,15 @@
 
 #include <fmt/format.h>
 
+#include "analysis/accuracy.hpp"
 #include "app/build_info.hpp"
 #include "app/process.hpp"
-#include "clothlab/accuracy.hpp"
-#include "clothlab/euler.hpp"
-#include "clothlab/gravity.hpp"
-#include "clothlab/integrator.hpp"
-#include "clothlab/output.hpp"
-#include "clothlab/scene.hpp"
-#include "clothlab/world.hpp"
+#include "clothlab/core/world.hpp"
+#include "clothlab/forces/gravity.hpp"
+#include "clothlab/integrators/euler.hpp"
+#include "clothlab/integrators/integrator.hpp"
+#include "io/output.hpp"
+#include "scene/scene.hpp"
 
 extern char** environ;
 

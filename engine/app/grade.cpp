@@ -25,7 +25,7 @@
 #include <fmt/core.h>
 #include <CLI/CLI.hpp>
 
-#include "clothlab/json.hpp"
+#include "io/json.hpp"
 
 #include <algorithm>
 #include <cerrno>

@@ -22,16 +22,16 @@
 #include <fmt/format.h>
 #include <CLI/CLI.hpp>
 
+#include "analysis/stability.hpp"
 #include "app/bench.hpp"
 #include "app/build_info.hpp"
 #include "app/demo_scene.hpp"
 #include "app/exit_codes.hpp"
 #include "app/grade.hpp"
-#include "clothlab/implicit_euler.hpp"
-#include "clothlab/not_implemented.hpp"
-#include "clothlab/run.hpp"
-#include "clothlab/scene.hpp"
-#include "clothlab/stability.hpp"
+#include "clothlab/core/not_implemented.hpp"
+#include "clothlab/integrators/implicit_euler.hpp"
+#include "io/run.hpp"
+#include "scene/scene.hpp"
 
 namespace fs = std::filesystem;
 using namespace clothlab;
@@ -99,9 +99,10 @@ void print_stats(const World& world, const StepTimes& times) {
       row(world.post_step_effects[k]->name(), times.post_step_effects[k]);
   }
   // What the fast engine (World::backend) took: its passes sum every effect at once, so they
-  // are timed as a whole. `[engine] fast_path = false` times each effect on its own instead.
+  // are timed as a whole. `--readable` times each effect on its own instead.
   if (times.backend_steps > 0) row("fast path: whole steps", times.backend_steps);
   if (times.backend_forces > 0) row("fast path: force sums", times.backend_forces);
+  if (fast) fmt::print("    (the fast path sums every effect at once; --readable times each)\n");
   row(fmt::format("{} (own)", world.integrator->name()), times.integrator);
   row("guard", times.guard);
   fmt::print("  force evaluations: {} ({} per step)\n", world.force_evaluations,
@@ -197,7 +198,12 @@ int main(int argc, char** argv) {
   run_cmd->add_flag("--no-html", no_html, "Write no viewer page");
   run_cmd->add_flag("--obj", obj, "Also write an OBJ sequence to <output folder>/frames/");
   run_cmd->add_flag("--vtk", vtk, "Also write a VTK series to <output folder>/frames/");
-  run_cmd->add_flag("--stats", stats, "Print the time spent in each effect of the scene");
+  run_cmd->add_flag("--stats", stats,
+                    "Print the time spent in each part of the step, on the path that runs");
+  bool readable = false;
+  run_cmd->add_flag("--readable", readable,
+                    "Take the lecture's path alone, without the fast path (as [engine] fast_path "
+                    "= false): the same result, slower; --stats then times each effect");
   int threads = -1;
   run_cmd
       ->add_option("--threads", threads,
@@ -230,6 +236,7 @@ int main(int argc, char** argv) {
       outputs.vtk = vtk;
       if (threads >= 0)
         scene.world.threads = threads > 0 ? threads : ThreadTeam::hardware_threads();
+      if (readable) scene.world.backend.reset();
       return run(scene, outputs, stats);
     }
     if (*validate_cmd) {

@@ -17,7 +17,7 @@
 #include <algorithm>
 #include <utility>
 
-#include "clothlab/aerodynamics.hpp"
+#include "clothlab/forces/aerodynamics.hpp"
 #include "fast/forces.hpp"
 
 namespace clothlab::fast {

@@ -4,7 +4,7 @@
 #include <array>
 #include <vector>
 
-#include "clothlab/triangles.hpp"
+#include "clothlab/core/triangles.hpp"
 
 namespace clothlab::fast {
 

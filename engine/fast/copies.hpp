@@ -11,7 +11,7 @@
 
 #include <cmath>
 
-#include "clothlab/types.hpp"
+#include "clothlab/core/types.hpp"
 
 namespace clothlab::fast {
 

@@ -3,9 +3,9 @@
 #include <algorithm>
 #include <atomic>
 
-#include "clothlab/euler.hpp"
-#include "clothlab/ground_collision.hpp"
-#include "clothlab/world.hpp"
+#include "clothlab/after_step/ground_collision.hpp"
+#include "clothlab/core/world.hpp"
+#include "clothlab/integrators/euler.hpp"
 
 namespace clothlab::fast {
 

@@ -1,4 +1,4 @@
-// engine.hpp: the fast engine, the world's backend (clothlab/backend.hpp) unless a scene says
+// engine.hpp: the fast engine, the world's backend (clothlab/core/backend.hpp) unless a scene says
 // `[engine] fast_path = false`.
 //
 // World::compute_forces_readable is the lecture's loop: clear every force, then let each effect
@@ -34,7 +34,7 @@
 #include <string>
 #include <vector>
 
-#include "clothlab/backend.hpp"
+#include "clothlab/core/backend.hpp"
 #include "fast/copies.hpp"
 #include "fast/forces.hpp"
 

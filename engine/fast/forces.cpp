@@ -2,10 +2,10 @@
 // damping, a fluid's drag): a loop over the range's particles, component by component.
 #include "fast/forces.hpp"
 
-#include "clothlab/aerodynamics.hpp"
-#include "clothlab/damping.hpp"
-#include "clothlab/gravity.hpp"
-#include "clothlab/spring_damper.hpp"
+#include "clothlab/forces/aerodynamics.hpp"
+#include "clothlab/forces/damping.hpp"
+#include "clothlab/forces/gravity.hpp"
+#include "clothlab/forces/spring_damper.hpp"
 
 namespace clothlab::fast {
 

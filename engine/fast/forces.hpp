@@ -10,7 +10,7 @@
 
 #include <memory>
 
-#include "clothlab/effect.hpp"
+#include "clothlab/core/effect.hpp"
 #include "fast/copies.hpp"
 
 namespace clothlab {

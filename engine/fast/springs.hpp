@@ -3,7 +3,7 @@
 
 #include <vector>
 
-#include "clothlab/spring_damper.hpp"
+#include "clothlab/forces/spring_damper.hpp"
 
 namespace clothlab::fast {
 

@@ -17,13 +17,15 @@
 
 #include <fmt/format.h>
 
-#include "clothlab/euler.hpp"
-#include "clothlab/gravitation.hpp"
-#include "clothlab/gravity.hpp"
-#include "clothlab/not_implemented.hpp"
-#include "clothlab/world.hpp"
+#include "../common/lesson.hpp"
+#include "clothlab/core/not_implemented.hpp"
+#include "clothlab/core/world.hpp"
+#include "clothlab/forces/gravitation.hpp"
+#include "clothlab/forces/gravity.hpp"
+#include "clothlab/integrators/euler.hpp"
 
 using namespace clothlab;
+using namespace clothlab::lesson;
 
 namespace {
 
@@ -160,16 +162,9 @@ void orbit_table() {
 }  // namespace
 
 int main() {
-  try {
+  return lesson::run("lesson01", [&] {
     free_fall_table();
     spring_table();
     orbit_table();
-  } catch (const NotImplemented& error) {
-    fmt::print(stderr, "lesson01: {}\n", error.what());
-    return 4;  // the same code `clothlab run` gives for a stub
-  } catch (const std::exception& error) {
-    fmt::print(stderr, "lesson01: {}\n", error.what());
-    return 1;
-  }
-  return 0;
+  });
 }

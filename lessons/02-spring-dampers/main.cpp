@@ -18,13 +18,15 @@
 
 #include <fmt/format.h>
 
-#include "clothlab/cloth.hpp"
-#include "clothlab/gravity.hpp"
-#include "clothlab/not_implemented.hpp"
-#include "clothlab/spring_damper.hpp"
-#include "clothlab/world.hpp"
+#include "../common/lesson.hpp"
+#include "clothlab/bodies/cloth.hpp"
+#include "clothlab/core/not_implemented.hpp"
+#include "clothlab/core/world.hpp"
+#include "clothlab/forces/gravity.hpp"
+#include "clothlab/forces/spring_damper.hpp"
 
 using namespace clothlab;
+using namespace clothlab::lesson;
 
 namespace {
 
@@ -184,17 +186,10 @@ void cloth_tables() {
 }  // namespace
 
 int main() {
-  try {
+  return lesson::run("lesson02", [&] {
     worked_force();
     period_table();
     damping_table();
     cloth_tables();
-  } catch (const NotImplemented& error) {
-    fmt::print(stderr, "lesson02: {}\n", error.what());
-    return 4;  // the same code `clothlab run` gives for a stub
-  } catch (const std::exception& error) {
-    fmt::print(stderr, "lesson02: {}\n", error.what());
-    return 1;
-  }
-  return 0;
+  });
 }

@@ -18,15 +18,17 @@
 
 #include <fmt/format.h>
 
-#include "clothlab/aerodynamics.hpp"
-#include "clothlab/bending.hpp"
-#include "clothlab/cloth.hpp"
-#include "clothlab/gravity.hpp"
-#include "clothlab/not_implemented.hpp"
-#include "clothlab/spring_damper.hpp"
-#include "clothlab/world.hpp"
+#include "../common/lesson.hpp"
+#include "clothlab/bodies/cloth.hpp"
+#include "clothlab/core/not_implemented.hpp"
+#include "clothlab/core/world.hpp"
+#include "clothlab/forces/aerodynamics.hpp"
+#include "clothlab/forces/bending.hpp"
+#include "clothlab/forces/gravity.hpp"
+#include "clothlab/forces/spring_damper.hpp"
 
 using namespace clothlab;
+using namespace clothlab::lesson;
 
 namespace {
 
@@ -175,16 +177,9 @@ void drape_table() {
 }  // namespace
 
 int main() {
-  try {
+  return lesson::run("lesson04", [&] {
     count_table();
     fold_table();
     drape_table();
-  } catch (const NotImplemented& error) {
-    fmt::print(stderr, "lesson04: {}\n", error.what());
-    return 4;  // the same code `clothlab run` gives for a stub
-  } catch (const std::exception& error) {
-    fmt::print(stderr, "lesson04: {}\n", error.what());
-    return 1;
-  }
-  return 0;
+  });
 }

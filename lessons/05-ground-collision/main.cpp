@@ -11,12 +11,14 @@
 
 #include <fmt/format.h>
 
-#include "clothlab/gravity.hpp"
-#include "clothlab/ground_collision.hpp"
-#include "clothlab/not_implemented.hpp"
-#include "clothlab/world.hpp"
+#include "../common/lesson.hpp"
+#include "clothlab/after_step/ground_collision.hpp"
+#include "clothlab/core/not_implemented.hpp"
+#include "clothlab/core/world.hpp"
+#include "clothlab/forces/gravity.hpp"
 
 using namespace clothlab;
+using namespace clothlab::lesson;
 
 namespace {
 
@@ -116,17 +118,10 @@ void simple_vs_coulomb() {
 }  // namespace
 
 int main() {
-  try {
+  return lesson::run("lesson05", [&] {
     worked_response();
     bounce_table();
     sliding_table();
     simple_vs_coulomb();
-  } catch (const NotImplemented& error) {
-    fmt::print(stderr, "lesson05: {}\n", error.what());
-    return 4;  // the same code `clothlab run` gives for a stub
-  } catch (const std::exception& error) {
-    fmt::print(stderr, "lesson05: {}\n", error.what());
-    return 1;
-  }
-  return 0;
+  });
 }

@@ -19,28 +19,19 @@
 
 #include <fmt/format.h>
 
-#include "clothlab/not_implemented.hpp"
-#include "clothlab/plasticity.hpp"
-#include "clothlab/scene.hpp"
-#include "clothlab/spring_damper.hpp"
-#include "clothlab/tearing.hpp"
+#include "../common/lesson.hpp"
+#include "clothlab/after_step/plasticity.hpp"
+#include "clothlab/after_step/tearing.hpp"
+#include "clothlab/core/not_implemented.hpp"
+#include "clothlab/forces/spring_damper.hpp"
+#include "scene/scene.hpp"
 
 using namespace clothlab;
+using namespace clothlab::lesson;
 
 namespace {
 
 using Ends = std::set<std::pair<Index, Index>>;
-
-// The scenes lie next to this file.
-std::filesystem::path lesson_file(const char* name) {
-  return std::filesystem::path(__FILE__).parent_path() / name;
-}
-
-SpringSet& springs_of(World& world) {
-  SpringDampers* springs = find_spring_effect(world, "springs");
-  if (!springs) throw std::runtime_error("the scene has no [springs]");
-  return springs->springs();
-}
 
 const Tearing* tearing_of(const World& world) {
   for (const auto& effect : world.post_step_effects)
@@ -198,13 +189,13 @@ void order_independence() {
 }  // namespace
 
 int main(int argc, char** argv) {
-  try {
+  return lesson::run("lesson06", [&] {
     if (argc > 1) {
       for (int a = 1; a < argc; ++a) {
         Scene scene = load_scene_file(argv[a]);
         tear_table(scene, argv[a]);
       }
-      return 0;
+      return;
     }
     one_spring();
     energy_sweep();
@@ -213,12 +204,5 @@ int main(int argc, char** argv) {
     tear_table(sheet, "tearing-sheet.toml");
     fmt::print("\n");
     order_independence();
-  } catch (const NotImplemented& error) {
-    fmt::print(stderr, "lesson06: {}\n", error.what());
-    return 4;  // the same code `clothlab run` gives for a stub
-  } catch (const std::exception& error) {
-    fmt::print(stderr, "lesson06: {}\n", error.what());
-    return 1;
-  }
-  return 0;
+  });
 }

@@ -24,21 +24,16 @@
 
 #include <fmt/format.h>
 
-#include "clothlab/implicit_euler.hpp"
-#include "clothlab/not_implemented.hpp"
-#include "clothlab/scene.hpp"
-#include "clothlab/spring_damper.hpp"
+#include "../common/lesson.hpp"
+#include "clothlab/core/not_implemented.hpp"
+#include "clothlab/forces/spring_damper.hpp"
+#include "clothlab/integrators/implicit_euler.hpp"
+#include "scene/scene.hpp"
 
 using namespace clothlab;
+using namespace clothlab::lesson;
 
 namespace {
-
-using Clock = std::chrono::steady_clock;
-
-// The scenes lie next to this file.
-std::filesystem::path lesson_file(const char* name) {
-  return std::filesystem::path(__FILE__).parent_path() / name;
-}
 
 // The scene at `path`, stepping with `method`. A scene that already names the method keeps its
 // own settings (the solver tolerance of implicit Euler).
@@ -49,10 +44,6 @@ Scene load_with(const std::filesystem::path& path, std::string_view method) {
     if (!scene.world.integrator) throw std::runtime_error("no integrator of that name");
   }
   return scene;
-}
-
-double energy(const World& world) {
-  return world.kinetic_energy() + world.potential_energy();
 }
 
 long solver_iterations(const World& world) {
@@ -82,12 +73,6 @@ struct Oscillator {
     return -std::exp(-zeta() * w() * t) * (w() * w() / wd()) * stretch * std::sin(wd() * t);
   }
 };
-
-SpringSet& springs_of(World& world) {
-  SpringDampers* springs = find_spring_effect(world, "springs");
-  if (!springs) throw std::runtime_error("the scene has no springs");
-  return springs->springs();
-}
 
 // The stretch [m] and the speed along the spring [m/s] of particle 1 in `world`.
 std::pair<double, double> stretch_and_speed(const World& world, double l0) {
@@ -392,23 +377,16 @@ void stiff_cloth() {
 }  // namespace
 
 int main(int argc, char** argv) {
-  try {
+  return lesson::run("lesson07", [&] {
     if (argc > 1) {
       for (int a = 1; a < argc; ++a)
         energy_table(argv[a]);
-      return 0;
+      return;
     }
     orders();
     energy_factors();
     stability_limits();
     energy_table(lesson_file("pendulum-cloth.toml"));
     stiff_cloth();
-  } catch (const NotImplemented& error) {
-    fmt::print(stderr, "lesson07: {}\n", error.what());
-    return 4;  // the same code `clothlab run` gives for a stub
-  } catch (const std::exception& error) {
-    fmt::print(stderr, "lesson07: {}\n", error.what());
-    return 1;
-  }
-  return 0;
+  });
 }

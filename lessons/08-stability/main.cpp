@@ -30,32 +30,20 @@
 #include <Eigen/Eigenvalues>
 #include <Eigen/SparseCore>
 
-#include "clothlab/cloth.hpp"
-#include "clothlab/implicit_euler.hpp"
-#include "clothlab/not_implemented.hpp"
-#include "clothlab/scene.hpp"
-#include "clothlab/spring_damper.hpp"
-#include "clothlab/stability.hpp"
+#include "../common/lesson.hpp"
+#include "analysis/stability.hpp"
+#include "clothlab/bodies/cloth.hpp"
+#include "clothlab/core/not_implemented.hpp"
+#include "clothlab/forces/spring_damper.hpp"
+#include "clothlab/integrators/implicit_euler.hpp"
+#include "scene/scene.hpp"
 
 using namespace clothlab;
+using namespace clothlab::lesson;
 
 namespace {
 
-using Clock = std::chrono::steady_clock;
 constexpr double kInfinity = std::numeric_limits<double>::infinity();
-
-// The scenes lie next to this file.
-std::filesystem::path lesson_file(const char* name) {
-  return std::filesystem::path(__FILE__).parent_path() / name;
-}
-
-double energy(const World& world) {
-  return world.kinetic_energy() + world.potential_energy();
-}
-
-double seconds_since(Clock::time_point start) {
-  return std::chrono::duration<double>(Clock::now() - start).count();
-}
 
 // "2.0000", "none" for 0 (unstable at every dt), "any" for infinity.
 std::string limit_text(double y) {
@@ -552,19 +540,12 @@ void stiff_sheet() {
 }  // namespace
 
 int main(int argc, char** argv) {
-  try {
+  return lesson::run("lesson08", [&] {
     limits_table();
     engine_limits();
     modified_energy();
     conservation();
     stiffest_mode(argc > 1 && std::string_view(argv[1]) == "--dense");
     stiff_sheet();
-  } catch (const NotImplemented& error) {
-    fmt::print(stderr, "lesson08: {}\n", error.what());
-    return 4;  // the same code `clothlab run` gives for a stub
-  } catch (const std::exception& error) {
-    fmt::print(stderr, "lesson08: {}\n", error.what());
-    return 1;
-  }
-  return 0;
+  });
 }

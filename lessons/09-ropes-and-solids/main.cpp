@@ -20,27 +20,18 @@
 
 #include <fmt/format.h>
 
-#include "clothlab/not_implemented.hpp"
-#include "clothlab/scene.hpp"
-#include "clothlab/solid.hpp"
-#include "clothlab/spring_damper.hpp"
-#include "clothlab/stability.hpp"
-#include "clothlab/strain_limiting.hpp"
+#include "../common/lesson.hpp"
+#include "analysis/stability.hpp"
+#include "clothlab/after_step/strain_limiting.hpp"
+#include "clothlab/bodies/solid.hpp"
+#include "clothlab/core/not_implemented.hpp"
+#include "clothlab/forces/spring_damper.hpp"
+#include "scene/scene.hpp"
 
 using namespace clothlab;
+using namespace clothlab::lesson;
 
 namespace {
-
-// The scenes lie next to this file.
-std::filesystem::path lesson_file(const char* name) {
-  return std::filesystem::path(__FILE__).parent_path() / name;
-}
-
-SpringSet& springs_of(World& world) {
-  SpringDampers* springs = find_spring_effect(world, "springs");
-  if (!springs) throw std::runtime_error("the scene has no [springs]");
-  return springs->springs();
-}
 
 const StrainLimiting* limiter_of(const World& world) {
   for (const auto& effect : world.post_step_effects)
@@ -117,7 +108,8 @@ Hanging hang(int sweeps, double stiffer, double dt) {
   for (size_t k = 0; k < springs.size(); ++k)
     springs.set_ks(k, stiffer * springs.ks(k));
   if (sweeps > 0)
-    w.post_step_effects.push_back(std::make_unique<StrainLimiting>(StrainLimits{0.1, 1.0}, sweeps));
+    w.post_step_effects.push_back(std::make_unique<StrainLimiting>(
+        *find_spring_effect(w, "springs"), StrainLimits{0.1, 1.0}, sweeps));
   const long steps = std::lround(scene.duration / dt);
   const auto start = std::chrono::steady_clock::now();
   for (long n = 0; n < steps; ++n)
@@ -230,23 +222,16 @@ void strain_table(const char* path) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  try {
+  return lesson::run("lesson09", [&] {
     if (argc > 1) {
       for (int a = 1; a < argc; ++a)
         strain_table(argv[a]);
-      return 0;
+      return;
     }
     one_spring();
     solid_counts();
     hanging_cloth();
     swinging_rope();
     jelly_cube();
-  } catch (const NotImplemented& error) {
-    fmt::print(stderr, "lesson09: {}\n", error.what());
-    return 4;  // the same code `clothlab run` gives for a stub
-  } catch (const std::exception& error) {
-    fmt::print(stderr, "lesson09: {}\n", error.what());
-    return 1;
-  }
-  return 0;
+  });
 }

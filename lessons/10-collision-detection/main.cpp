@@ -21,25 +21,16 @@
 
 #include <fmt/format.h>
 
-#include "clothlab/not_implemented.hpp"
-#include "clothlab/scene.hpp"
-#include "clothlab/self_collision.hpp"
-#include "clothlab/spatial_hash.hpp"
+#include "../common/lesson.hpp"
+#include "clothlab/after_step/self_collision.hpp"
+#include "clothlab/after_step/spatial_hash.hpp"
+#include "clothlab/core/not_implemented.hpp"
+#include "scene/scene.hpp"
 
 using namespace clothlab;
+using namespace clothlab::lesson;
 
 namespace {
-
-using Clock = std::chrono::steady_clock;
-
-double seconds_since(Clock::time_point start) {
-  return std::chrono::duration<double>(Clock::now() - start).count();
-}
-
-// The scenes lie next to this file.
-std::filesystem::path lesson_file(const char* name) {
-  return std::filesystem::path(__FILE__).parent_path() / name;
-}
 
 SelfCollision* self_collision_of(World& world) {
   for (const auto& effect : world.post_step_effects)
@@ -266,22 +257,15 @@ void closest_table(const char* path) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  try {
+  return lesson::run("lesson10", [&] {
     if (argc > 1) {
       for (int a = 1; a < argc; ++a)
         closest_table(argv[a]);
-      return 0;
+      return;
     }
     by_hand();
     broad_phase();
     towels();
     ball();
-  } catch (const NotImplemented& error) {
-    fmt::print(stderr, "lesson10: {}\n", error.what());
-    return 4;  // the same code `clothlab run` gives for a stub
-  } catch (const std::exception& error) {
-    fmt::print(stderr, "lesson10: {}\n", error.what());
-    return 1;
-  }
-  return 0;
+  });
 }

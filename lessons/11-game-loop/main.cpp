@@ -22,11 +22,13 @@
 
 #include <fmt/format.h>
 
-#include "clothlab/game_loop.hpp"
-#include "clothlab/not_implemented.hpp"
-#include "clothlab/viewer.hpp"
+#include "../common/lesson.hpp"
+#include "clothlab/core/game_loop.hpp"
+#include "clothlab/core/not_implemented.hpp"
+#include "io/viewer.hpp"
 
 using namespace clothlab;
+using namespace clothlab::lesson;
 
 namespace {
 
@@ -201,7 +203,7 @@ void spiral_of_death() {
 }  // namespace
 
 int main(int argc, char** argv) {
-  try {
+  return lesson::run("lesson11", [&]() -> int {
     std::string view;
     if (argc == 3 && std::string(argv[1]) == "--view") {
       view = argv[2];
@@ -221,12 +223,6 @@ int main(int argc, char** argv) {
                ramped.largest_jerk, instant.largest_jerk,
                instant.largest_jerk / ramped.largest_jerk);
     spiral_of_death();
-  } catch (const NotImplemented& error) {
-    fmt::print(stderr, "lesson11: {}\n", error.what());
-    return 4;  // the same code `clothlab run` gives for a stub
-  } catch (const std::exception& error) {
-    fmt::print(stderr, "lesson11: {}\n", error.what());
-    return 1;
-  }
-  return 0;
+    return 0;
+  });
 }

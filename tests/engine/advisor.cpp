@@ -12,14 +12,14 @@
 
 #include <Eigen/Eigenvalues>
 
-#include "clothlab/damping.hpp"
-#include "clothlab/gravity.hpp"
-#include "clothlab/implicit_euler.hpp"
-#include "clothlab/integrator.hpp"
-#include "clothlab/scene.hpp"
-#include "clothlab/spring_damper.hpp"
-#include "clothlab/stability.hpp"
-#include "clothlab/world.hpp"
+#include "analysis/stability.hpp"
+#include "clothlab/core/world.hpp"
+#include "clothlab/forces/damping.hpp"
+#include "clothlab/forces/gravity.hpp"
+#include "clothlab/forces/spring_damper.hpp"
+#include "clothlab/integrators/implicit_euler.hpp"
+#include "clothlab/integrators/integrator.hpp"
+#include "scene/scene.hpp"
 #include "test_util.hpp"
 
 using clothlab::Index;

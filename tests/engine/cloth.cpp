@@ -7,12 +7,12 @@
 #include <random>
 #include <string>
 
-#include "clothlab/aerodynamics.hpp"
-#include "clothlab/bending.hpp"
-#include "clothlab/cloth.hpp"
-#include "clothlab/gravity.hpp"
-#include "clothlab/scene.hpp"
-#include "clothlab/spring_damper.hpp"
+#include "clothlab/bodies/cloth.hpp"
+#include "clothlab/forces/aerodynamics.hpp"
+#include "clothlab/forces/bending.hpp"
+#include "clothlab/forces/gravity.hpp"
+#include "clothlab/forces/spring_damper.hpp"
+#include "scene/scene.hpp"
 #include "test_util.hpp"
 
 using clothlab::Index;

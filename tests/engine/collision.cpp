@@ -3,8 +3,8 @@
 
 #include <string>
 
-#include "clothlab/ground_collision.hpp"
-#include "clothlab/scene.hpp"
+#include "clothlab/after_step/ground_collision.hpp"
+#include "scene/scene.hpp"
 #include "test_util.hpp"
 
 using clothlab::Index;

@@ -3,8 +3,8 @@
 
 #include <string>
 
-#include "clothlab/gravity.hpp"
-#include "clothlab/scene.hpp"
+#include "clothlab/forces/gravity.hpp"
+#include "scene/scene.hpp"
 #include "test_util.hpp"
 
 namespace {

@@ -9,9 +9,9 @@
 #include <string>
 #include <vector>
 
-#include "clothlab/aerodynamics.hpp"
-#include "clothlab/game_loop.hpp"
-#include "clothlab/guard.hpp"
+#include "clothlab/core/game_loop.hpp"
+#include "clothlab/core/guard.hpp"
+#include "clothlab/forces/aerodynamics.hpp"
 
 using clothlab::Index;
 using clothlab::Matrix3X;

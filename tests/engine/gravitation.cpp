@@ -3,8 +3,8 @@
 
 #include <cmath>
 
-#include "clothlab/gravitation.hpp"
-#include "clothlab/world.hpp"
+#include "clothlab/core/world.hpp"
+#include "clothlab/forces/gravitation.hpp"
 
 using clothlab::Vec3;
 

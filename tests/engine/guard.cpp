@@ -4,8 +4,8 @@
 #include <limits>
 #include <string>
 
-#include "clothlab/gravity.hpp"
-#include "clothlab/scene.hpp"
+#include "clothlab/forces/gravity.hpp"
+#include "scene/scene.hpp"
 #include "test_util.hpp"
 
 using clothlab::Vec3;

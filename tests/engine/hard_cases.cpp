@@ -28,10 +28,10 @@
 #include <utility>
 #include <vector>
 
-#include "clothlab/aerodynamics.hpp"
-#include "clothlab/implicit_euler.hpp"
-#include "clothlab/scene.hpp"
-#include "clothlab/spring_damper.hpp"
+#include "clothlab/forces/aerodynamics.hpp"
+#include "clothlab/forces/spring_damper.hpp"
+#include "clothlab/integrators/implicit_euler.hpp"
+#include "scene/scene.hpp"
 #include "test_util.hpp"
 
 using clothlab::Index;

@@ -17,13 +17,13 @@
 #include <string>
 #include <vector>
 
-#include "clothlab/cloth.hpp"
-#include "clothlab/damping.hpp"
-#include "clothlab/gravity.hpp"
-#include "clothlab/implicit_euler.hpp"
-#include "clothlab/scene.hpp"
-#include "clothlab/spring_damper.hpp"
-#include "clothlab/world.hpp"
+#include "clothlab/bodies/cloth.hpp"
+#include "clothlab/core/world.hpp"
+#include "clothlab/forces/damping.hpp"
+#include "clothlab/forces/gravity.hpp"
+#include "clothlab/forces/spring_damper.hpp"
+#include "clothlab/integrators/implicit_euler.hpp"
+#include "scene/scene.hpp"
 #include "test_util.hpp"
 
 using clothlab::Index;

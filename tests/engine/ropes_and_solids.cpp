@@ -8,10 +8,10 @@
 #include <set>
 #include <string>
 
-#include "clothlab/scene.hpp"
-#include "clothlab/solid.hpp"
-#include "clothlab/spring_damper.hpp"
-#include "clothlab/strain_limiting.hpp"
+#include "clothlab/after_step/strain_limiting.hpp"
+#include "clothlab/bodies/solid.hpp"
+#include "clothlab/forces/spring_damper.hpp"
+#include "scene/scene.hpp"
 #include "test_util.hpp"
 
 using clothlab::Index;
@@ -144,7 +144,7 @@ TEST_CASE("strain limiting: a correction between two free particles keeps moment
   clothlab::SpringSet s;
   s.add(0, 1, 10.0, 0.0, 1.0, w.particles.x);
   w.force_effects.push_back(std::make_unique<clothlab::SpringDampers>("springs", s));
-  clothlab::StrainLimiting limiter({0.1, 1.0}, 10);
+  clothlab::StrainLimiting limiter(*clothlab::find_spring_effect(w, "springs"), {0.1, 1.0}, 10);
   const Vec3 momentum = w.momentum();
   const Vec3 centre = w.particles.x * w.particles.m / 4.0;
   const double dt = 0.01;  // [s]

@@ -10,8 +10,8 @@
 #include <string>
 #include <vector>
 
-#include "clothlab/run.hpp"
-#include "clothlab/scene.hpp"
+#include "io/run.hpp"
+#include "scene/scene.hpp"
 
 namespace fs = std::filesystem;
 

@@ -7,7 +7,7 @@
 #include <fstream>
 #include <string>
 
-#include "clothlab/scene.hpp"
+#include "scene/scene.hpp"
 
 namespace fs = std::filesystem;
 

@@ -8,9 +8,9 @@
 #include <string>
 #include <vector>
 
-#include "clothlab/scene.hpp"
-#include "clothlab/self_collision.hpp"
-#include "clothlab/spatial_hash.hpp"
+#include "clothlab/after_step/self_collision.hpp"
+#include "clothlab/after_step/spatial_hash.hpp"
+#include "scene/scene.hpp"
 #include "test_util.hpp"
 
 using clothlab::Index;

@@ -29,10 +29,10 @@
 #include <string>
 #include <vector>
 
-#include "clothlab/cloth.hpp"
-#include "clothlab/implicit_euler.hpp"
-#include "clothlab/spring_damper.hpp"
-#include "clothlab/world.hpp"
+#include "clothlab/bodies/cloth.hpp"
+#include "clothlab/core/world.hpp"
+#include "clothlab/forces/spring_damper.hpp"
+#include "clothlab/integrators/implicit_euler.hpp"
 #include "test_util.hpp"
 
 using clothlab::Vec3;

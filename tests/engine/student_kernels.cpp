@@ -6,9 +6,9 @@
 
 #include <string>
 
-#include "clothlab/not_implemented.hpp"
-#include "clothlab/scene.hpp"
-#include "clothlab/self_collision.hpp"
+#include "clothlab/after_step/self_collision.hpp"
+#include "clothlab/core/not_implemented.hpp"
+#include "scene/scene.hpp"
 
 namespace {
 

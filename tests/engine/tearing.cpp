@@ -6,11 +6,11 @@
 #include <set>
 #include <string>
 
-#include "clothlab/aerodynamics.hpp"
-#include "clothlab/plasticity.hpp"
-#include "clothlab/scene.hpp"
-#include "clothlab/spring_damper.hpp"
-#include "clothlab/tearing.hpp"
+#include "clothlab/after_step/plasticity.hpp"
+#include "clothlab/after_step/tearing.hpp"
+#include "clothlab/forces/aerodynamics.hpp"
+#include "clothlab/forces/spring_damper.hpp"
+#include "scene/scene.hpp"
 #include "test_util.hpp"
 
 using clothlab::Index;
@@ -48,7 +48,7 @@ TEST_CASE("plasticity: plastic flow never adds energy to a spring") {
     scene.world.step(scene.dt);  // the storm stretches it
   clothlab::SpringDampers& springs = test::spring_effect(scene.world);
   const double before = springs.potential_energy(scene.world.particles, scene.world.particles.x);
-  clothlab::Plasticity plasticity({0.02, 1e9, 0.9});  // flow all the way at once
+  clothlab::Plasticity plasticity(springs, {0.02, 1e9, 0.9});  // flow all the way at once
   plasticity.apply(scene.world, scene.dt);
   const double after = springs.potential_energy(scene.world.particles, scene.world.particles.x);
   CHECK(after <= before);
@@ -109,7 +109,15 @@ TEST_CASE("tearing: which springs tear does not depend on their order in the lis
     b.world.particles = a.world.particles;
     clothlab::SpringSet& sb = test::springs_of(b.world);
     sb.reverse();
-    clothlab::Tearing ta(0.05, max_tears), tb(0.05, max_tears);
+    // As a scene makes it: the world's springs, its bending springs and its air's triangles.
+    const auto tearing = [&](clothlab::World& w) {
+      std::vector<clothlab::Aerodynamics*> aero;
+      for (auto& effect : w.force_effects)
+        if (auto* air = dynamic_cast<clothlab::Aerodynamics*>(effect.get())) aero.push_back(air);
+      return clothlab::Tearing(test::spring_effect(w), clothlab::find_spring_effect(w, "bending"),
+                               aero, 0.05, max_tears);
+    };
+    clothlab::Tearing ta = tearing(a.world), tb = tearing(b.world);
     ta.apply(a.world, a.dt);
     tb.apply(b.world, b.dt);
     CHECK(ta.torn() > 0);

@@ -12,13 +12,13 @@
 #include <utility>
 #include <vector>
 
-#include "clothlab/cloth.hpp"
-#include "clothlab/euler.hpp"
-#include "clothlab/gravity.hpp"
-#include "clothlab/integrator.hpp"
-#include "clothlab/scene.hpp"
-#include "clothlab/spring_damper.hpp"
-#include "clothlab/world.hpp"
+#include "clothlab/bodies/cloth.hpp"
+#include "clothlab/core/world.hpp"
+#include "clothlab/forces/gravity.hpp"
+#include "clothlab/forces/spring_damper.hpp"
+#include "clothlab/integrators/euler.hpp"
+#include "clothlab/integrators/integrator.hpp"
+#include "scene/scene.hpp"
 
 namespace test {
 

@@ -16,15 +16,15 @@
 #include <utility>
 #include <vector>
 
-#include "clothlab/aerodynamics.hpp"
-#include "clothlab/bending.hpp"
-#include "clothlab/cloth.hpp"
-#include "clothlab/scene.hpp"
-#include "clothlab/spring_damper.hpp"
-#include "clothlab/threads.hpp"
+#include "clothlab/bodies/cloth.hpp"
+#include "clothlab/core/threads.hpp"
+#include "clothlab/forces/aerodynamics.hpp"
+#include "clothlab/forces/bending.hpp"
+#include "clothlab/forces/spring_damper.hpp"
 #include "fast/aerodynamics.hpp"
 #include "fast/engine.hpp"
 #include "fast/springs.hpp"
+#include "scene/scene.hpp"
 #include "test_util.hpp"
 
 using clothlab::Index;
@@ -697,7 +697,8 @@ TEST_CASE(
     for (int step = 0; step < 20; ++step)
       scene.world.step(scene.dt);
     REQUIRE(scene.world.post_step_effects.front()->name() == "ground");
-    CHECK((times.post_step_effects.front() == 0.0) == fast);
+    const double ground = times.post_step_effects.empty() ? 0.0 : times.post_step_effects.front();
+    CHECK((ground == 0.0) == fast);
     CHECK((times.backend_steps > 0.0) == fast);
   }
   // Behind an effect that reads the whole state, the ground waits until the step has moved

@@ -9,10 +9,10 @@
 #include <cstdlib>
 #include <string_view>
 
-#include "clothlab/guard.hpp"
-#include "clothlab/implicit_euler.hpp"
-#include "clothlab/integrator.hpp"
-#include "clothlab/scene.hpp"
+#include "clothlab/core/guard.hpp"
+#include "clothlab/integrators/implicit_euler.hpp"
+#include "clothlab/integrators/integrator.hpp"
+#include "scene/scene.hpp"
 
 namespace {
 

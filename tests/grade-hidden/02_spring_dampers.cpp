@@ -7,7 +7,7 @@
 #include <array>
 #include <cmath>
 
-#include "clothlab/spring_damper.hpp"
+#include "clothlab/forces/spring_damper.hpp"
 #include "grading.hpp"
 
 using clothlab::Mat3;

@@ -6,9 +6,9 @@
 #include <cmath>
 #include <numbers>
 
-#include "clothlab/euler.hpp"
-#include "clothlab/gravitation.hpp"
-#include "clothlab/gravity.hpp"
+#include "clothlab/forces/gravitation.hpp"
+#include "clothlab/forces/gravity.hpp"
+#include "clothlab/integrators/euler.hpp"
 #include "grading.hpp"
 
 using clothlab::PointState;

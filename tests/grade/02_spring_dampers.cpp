@@ -9,7 +9,7 @@
 #include <sstream>
 #include <string>
 
-#include "clothlab/spring_damper.hpp"
+#include "clothlab/forces/spring_damper.hpp"
 #include "grading.hpp"
 
 using clothlab::Vec3;

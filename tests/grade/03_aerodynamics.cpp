@@ -9,7 +9,7 @@
 #include <sstream>
 #include <string>
 
-#include "clothlab/aerodynamics.hpp"
+#include "clothlab/forces/aerodynamics.hpp"
 #include "grading.hpp"
 
 using clothlab::Vec3;

@@ -12,7 +12,7 @@
 #include <utility>
 #include <vector>
 
-#include "clothlab/cloth.hpp"
+#include "clothlab/bodies/cloth.hpp"
 #include "grading.hpp"
 
 using clothlab::Index;

@@ -8,7 +8,7 @@
 #include <sstream>
 #include <string>
 
-#include "clothlab/ground_collision.hpp"
+#include "clothlab/after_step/ground_collision.hpp"
 #include "grading.hpp"
 
 using clothlab::Vec3;

@@ -13,8 +13,8 @@
 #include <utility>
 #include <vector>
 
-#include "clothlab/plasticity.hpp"
-#include "clothlab/tearing.hpp"
+#include "clothlab/after_step/plasticity.hpp"
+#include "clothlab/after_step/tearing.hpp"
 #include "grading.hpp"
 
 using clothlab::Index;

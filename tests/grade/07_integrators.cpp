@@ -13,7 +13,7 @@
 #include <string>
 #include <vector>
 
-#include "clothlab/runge_kutta.hpp"
+#include "clothlab/integrators/runge_kutta.hpp"
 #include "grading.hpp"
 
 using clothlab::AccelerationField;

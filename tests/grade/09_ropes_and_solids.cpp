@@ -9,7 +9,7 @@
 #include <array>
 #include <cmath>
 
-#include "clothlab/strain_limiting.hpp"
+#include "clothlab/after_step/strain_limiting.hpp"
 #include "grading.hpp"
 
 using clothlab::StrainCorrection;

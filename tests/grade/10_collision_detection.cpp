@@ -15,8 +15,8 @@
 #include <sstream>
 #include <string>
 
-#include "clothlab/self_collision.hpp"
-#include "clothlab/spatial_hash.hpp"
+#include "clothlab/after_step/self_collision.hpp"
+#include "clothlab/after_step/spatial_hash.hpp"
 #include "grading.hpp"
 
 using clothlab::Cell;

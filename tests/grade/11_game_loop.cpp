@@ -8,7 +8,7 @@
 #include <cmath>
 #include <vector>
 
-#include "clothlab/game_loop.hpp"
+#include "clothlab/core/game_loop.hpp"
 #include "grading.hpp"
 
 using clothlab::Substeps;

@@ -21,7 +21,7 @@
 #include <sstream>
 #include <string>
 
-#include "clothlab/types.hpp"
+#include "clothlab/core/types.hpp"
 
 #define POINTS(n) doctest::description("points=" #n)
 #define POINTS_VISIBILITY(n, visibility) \

@@ -21,7 +21,7 @@
 #include <thread>
 #include <vector>
 
-#include "clothlab/not_implemented.hpp"
+#include "clothlab/core/not_implemented.hpp"
 #include "kernel_wire.hpp"
 
 namespace clothlab {

@@ -12,7 +12,7 @@
 #include <exception>
 #include <string>
 
-#include "clothlab/not_implemented.hpp"
+#include "clothlab/core/not_implemented.hpp"
 #include "kernel_wire.hpp"
 
 namespace {

@@ -44,21 +44,21 @@
 #include <utility>
 #include <vector>
 
-#include "clothlab/aerodynamics.hpp"
-#include "clothlab/cloth.hpp"
-#include "clothlab/euler.hpp"
-#include "clothlab/game_loop.hpp"
-#include "clothlab/gravitation.hpp"
-#include "clothlab/gravity.hpp"
-#include "clothlab/ground_collision.hpp"
-#include "clothlab/plasticity.hpp"
-#include "clothlab/runge_kutta.hpp"
-#include "clothlab/self_collision.hpp"
-#include "clothlab/spatial_hash.hpp"
-#include "clothlab/spring_damper.hpp"
-#include "clothlab/strain_limiting.hpp"
-#include "clothlab/tearing.hpp"
-#include "clothlab/types.hpp"
+#include "clothlab/after_step/ground_collision.hpp"
+#include "clothlab/after_step/plasticity.hpp"
+#include "clothlab/after_step/self_collision.hpp"
+#include "clothlab/after_step/spatial_hash.hpp"
+#include "clothlab/after_step/strain_limiting.hpp"
+#include "clothlab/after_step/tearing.hpp"
+#include "clothlab/bodies/cloth.hpp"
+#include "clothlab/core/game_loop.hpp"
+#include "clothlab/core/types.hpp"
+#include "clothlab/forces/aerodynamics.hpp"
+#include "clothlab/forces/gravitation.hpp"
+#include "clothlab/forces/gravity.hpp"
+#include "clothlab/forces/spring_damper.hpp"
+#include "clothlab/integrators/euler.hpp"
+#include "clothlab/integrators/runge_kutta.hpp"
 
 namespace clothlab::wire {
 

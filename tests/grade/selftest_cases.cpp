@@ -14,7 +14,7 @@
 #include <string>
 #include <thread>
 
-#include "clothlab/not_implemented.hpp"
+#include "clothlab/core/not_implemented.hpp"
 #include "grading.hpp"
 
 TEST_SUITE("ex90") {

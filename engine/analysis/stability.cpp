@@ -1,0 +1,242 @@
+#include "analysis/stability.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <functional>
+#include <stdexcept>
+#include <utility>
+#include <vector>
+
+#include <fmt/format.h>
+#include <Eigen/Eigenvalues>
+
+namespace clothlab {
+
+namespace {
+
+using Matrix = Eigen::MatrixXd;
+using Vector = Eigen::VectorXd;
+constexpr double kInfinity = std::numeric_limits<double>::infinity();
+
+// The matrix of a linear map, column by column: the map applied to each basis vector.
+Matrix matrix_of(int n, const std::function<Vector(const Vector&)>& step) {
+  Matrix a(n, n);
+  for (int k = 0; k < n; ++k)
+    a.col(k) = step(Vector::Unit(n, k));
+  return a;
+}
+
+// The biggest factor by which the stiffest mode's amplitude grows in `steps` steps at dt, for
+// the worse of the two damping bounds.
+double growth_over(std::string_view integrator, double dt, double steps, const StiffnessBounds& b) {
+  const double rho =
+      std::max(spectral_radius(oscillator_step_matrix(integrator, dt, b.omega_max, b.beta_min)),
+               spectral_radius(oscillator_step_matrix(integrator, dt, b.omega_max, b.beta_max)));
+  return std::pow(rho, steps);
+}
+
+// Collects block Gershgorin row sums of M^-1/2 K M^-1/2 and of the damping blocks: for row i,
+// the largest |eigenvalue| of the diagonal block (the sum of every block that lands there, so
+// springs pulling in different directions are not counted as if they were parallel) plus the
+// spectral norm of each off-diagonal block.
+class GershgorinRows final : public ForceJacobians {
+ public:
+  explicit GershgorinRows(const Particles& p)
+      : p_(p),
+        k_diagonal_(p.size(), Mat3::Zero()),
+        c_diagonal_(p.size(), Mat3::Zero()),
+        k_off_(VectorX::Zero(p.size())),
+        c_off_(VectorX::Zero(p.size())),
+        c_self_(p.size(), Mat3::Zero()) {}
+
+  void add_pair(Index i, Index j, const Mat3& dfdx, const Mat3& dfdv) override {
+    const double k = norm(dfdx), c = norm(dfdv);
+    for (const auto& [a, b] : {std::pair{i, j}, std::pair{j, i}}) {
+      if (p_.inv_m[a] == 0.0) continue;  // a pinned particle is not an unknown
+      k_diagonal_[a] += dfdx;
+      c_diagonal_[a] += dfdv;
+      // Off the diagonal: |K_ab| / sqrt(m_a m_b), nothing when b is pinned.
+      k_off_[a] += k * std::sqrt(p_.inv_m[a] * p_.inv_m[b]);
+      c_off_[a] += c * std::sqrt(p_.inv_m[a] * p_.inv_m[b]);
+    }
+  }
+
+  void add_self(Index i, const Mat3& dfdx, const Mat3& dfdv) override {
+    if (p_.inv_m[i] == 0.0) return;
+    k_diagonal_[i] -= dfdx;
+    c_diagonal_[i] -= dfdv;
+    c_self_[i] -= dfdv;
+  }
+
+  StiffnessBounds bounds() const {
+    StiffnessBounds b;
+    bool any_free = false;
+    b.beta_min = kInfinity;
+    for (Index i = 0; i < p_.size(); ++i) {
+      if (p_.inv_m[i] == 0.0) continue;
+      any_free = true;
+      b.omega_max = std::max(b.omega_max, norm(k_diagonal_[i]) * p_.inv_m[i] + k_off_[i]);
+      b.beta_max = std::max(b.beta_max, norm(c_diagonal_[i]) * p_.inv_m[i] + c_off_[i]);
+      // The damping every direction of this particle gets: the smallest eigenvalue of its own
+      // damping block ([damping] rate m I gives the rate).
+      Eigen::SelfAdjointEigenSolver<Mat3> eigen;
+      eigen.computeDirect(c_self_[i], Eigen::EigenvaluesOnly);
+      b.beta_min =
+          std::min(b.beta_min, std::max(0.0, eigen.eigenvalues().minCoeff()) * p_.inv_m[i]);
+    }
+    b.omega_max = std::sqrt(b.omega_max);
+    if (!any_free) b.beta_min = 0.0;
+    return b;
+  }
+
+ private:
+  static double norm(const Mat3& block) {
+    Eigen::SelfAdjointEigenSolver<Mat3> eigen;
+    eigen.computeDirect(block, Eigen::EigenvaluesOnly);
+    return eigen.eigenvalues().cwiseAbs().maxCoeff();
+  }
+
+  const Particles& p_;
+  std::vector<Mat3> k_diagonal_, c_diagonal_;  // the diagonal blocks -K_ii and -D_ii
+  VectorX k_off_, c_off_;                      // scaled off-diagonal block norms
+  std::vector<Mat3> c_self_;                   // damping each particle has on its own
+};
+
+}  // namespace
+
+Matrix oscillator_step_matrix(std::string_view integrator, double dt, double omega, double beta) {
+  const double h = dt, w2 = omega * omega;
+  // The oscillator's acceleration.
+  const auto a = [&](double x, double v) { return -w2 * x - beta * v; };
+  const auto state = [](double x, double v) { return Vector((Vector(2) << x, v).finished()); };
+
+  if (integrator == "explicit-euler") {
+    return matrix_of(
+        2, [&](const Vector& s) { return state(s[0] + h * s[1], s[1] + h * a(s[0], s[1])); });
+  }
+  if (integrator == "symplectic-euler") {
+    return matrix_of(2, [&](const Vector& s) {
+      const double v = s[1] + h * a(s[0], s[1]);
+      return state(s[0] + h * v, v);
+    });
+  }
+  if (integrator == "midpoint" || integrator == "rk4" || integrator == "implicit-euler") {
+    // On a linear system these are functions of J = [[0, 1], [-w^2, -beta]]:
+    // midpoint I + hJ + (hJ)^2/2, RK4 the Taylor series of exp(hJ) to (hJ)^4/24, implicit
+    // Euler (I - hJ)^-1 (its single linearisation is exact for a linear spring).
+    Matrix j(2, 2);
+    j << 0.0, 1.0, -w2, -beta;
+    const Matrix hj = h * j, i = Matrix::Identity(2, 2);
+    if (integrator == "implicit-euler") return (i - hj).inverse();
+    Matrix sum = i, term = i;
+    const int order = integrator == "midpoint" ? 2 : 4;
+    for (int k = 1; k <= order; ++k) {
+      term = term * hj / k;
+      sum += term;
+    }
+    return sum;
+  }
+  if (integrator == "velocity-verlet") {
+    // As VelocityVerlet::advance: the second acceleration at the predicted velocity v + h a.
+    return matrix_of(2, [&](const Vector& s) {
+      const double a0 = a(s[0], s[1]);
+      const double v_half = s[1] + 0.5 * h * a0;
+      const double x = s[0] + h * v_half;
+      return state(x, v_half + 0.5 * h * a(x, s[1] + h * a0));
+    });
+  }
+  if (integrator == "position-verlet") {
+    // State (x_n, x_n-1, a_n-1), as PositionVerlet::advance keeps it: the velocity it reports
+    // is v_n = (x_n - x_n-1) / h + h/2 a_n-1.
+    return matrix_of(3, [&](const Vector& s) {
+      const double v = (s[0] - s[1]) / h + 0.5 * h * s[2];
+      const double an = a(s[0], v);
+      return Vector((Vector(3) << 2.0 * s[0] - s[1] + h * h * an, s[0], an).finished());
+    });
+  }
+  throw std::invalid_argument(fmt::format("no step matrix for integrator '{}'", integrator));
+}
+
+double spectral_radius(const Matrix& a) {
+  return a.eigenvalues().cwiseAbs().maxCoeff();
+}
+
+double oscillator_dt_limit(std::string_view integrator, double omega, double beta) {
+  // Stable: no eigenvalue outside the unit circle (beyond rounding).
+  const auto stable = [&](double h) {
+    return spectral_radius(oscillator_step_matrix(integrator, h, omega, beta)) <= 1.0 + 1e-12;
+  };
+  // At y = 0.01 the growth of explicit Euler (y^2 / 2 a step) and of midpoint (y^4 / 8) still
+  // shows above rounding: a method unstable there is "unstable at every dt" for any practical
+  // purpose, even if some damping would make a yet smaller dt stable.
+  double lo = 1e-2 / omega;
+  if (!stable(lo)) return 0.0;
+  double hi = 1.0 / omega;
+  while (stable(hi)) {
+    lo = hi;
+    hi *= 2.0;
+    if (hi > 1e6 / omega) return kInfinity;
+  }
+  for (int k = 0; k < 60; ++k) {
+    const double mid = 0.5 * (lo + hi);
+    (stable(mid) ? lo : hi) = mid;
+  }
+  return lo;
+}
+
+StiffnessBounds stiffness_bounds(const World& world) {
+  const Particles& p = world.particles;
+  GershgorinRows rows(p);
+  for (const auto& effect : world.force_effects)
+    effect->add_jacobians(p, p.x, p.v, rows);
+  return rows.bounds();
+}
+
+TimeStepAdvice advise_time_step(const World& world, double dt, long steps) {
+  TimeStepAdvice advice;
+  advice.bounds = stiffness_bounds(world);
+  const StiffnessBounds& b = advice.bounds;
+  if (!world.integrator || b.omega_max == 0.0) return advice;  // no springs: nothing to limit
+  const std::string method(world.integrator->name());
+  advice.dt_limit = std::min(oscillator_dt_limit(method, b.omega_max, b.beta_min),
+                             oscillator_dt_limit(method, b.omega_max, b.beta_max));
+  advice.growth = growth_over(method, dt, static_cast<double>(steps), b);
+  if (advice.growth <= 2.0) return advice;
+
+  // A dt at which the run stays within a factor 2: below the limit, and short enough that a
+  // method unstable at every dt grows by at most 2 over the scene's duration.
+  const double duration = dt * static_cast<double>(steps);
+  double lo = 0.0, hi = dt;
+  for (int k = 0; k < 60; ++k) {
+    const double mid = 0.5 * (lo + hi);
+    (growth_over(method, mid, duration / mid, b) <= 2.0 ? lo : hi) = mid;
+  }
+  const double suggested = 0.9 * lo;
+
+  const std::string mode = fmt::format(
+      "its stiffest mode (w <= {:.4g} rad/s, damping up to {:.3g} 1/s, by Gershgorin's bound)",
+      b.omega_max, b.beta_max);
+  const std::string growth = std::isfinite(advice.growth) && advice.growth < 1e300
+                                 ? fmt::format("{:.3g}", advice.growth)
+                                 : std::string("more than 1e300");
+  std::string why;
+  if (advice.dt_limit > 0.0) {
+    why = fmt::format(
+        "dt = {} s is above the stability limit of {} for this scene, about {:.3g} s: {} would "
+        "grow by a factor of {} over the run's {} steps",
+        dt, method, advice.dt_limit, mode, growth, steps);
+  } else {
+    why = fmt::format(
+        "{} adds energy at every step on undamped springs: at dt = {} s {} would grow by a "
+        "factor of {} over the run's {} steps",
+        method, dt, mode, growth, steps);
+  }
+  advice.warning = fmt::format(
+      "{}. Take dt <= {:.3g} s ({:.0f} times smaller), or method = \"implicit-euler\", which "
+      "is stable at any dt{}",
+      why, suggested, std::ceil(dt / suggested),
+      advice.dt_limit > 0.0 ? "" : ", or \"symplectic-euler\", which keeps energy bounded");
+  return advice;
+}
+
+}  // namespace clothlab

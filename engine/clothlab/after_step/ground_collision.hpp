@@ -1,0 +1,78 @@
+// ground_collision.hpp: particles meeting the ground and solid spheres (lesson 05).
+//
+// Detection and response are separate. Detection (here, in the engine) finds a particle that
+// has ended a step inside a solid: below the ground plane y = y0, or inside a sphere. It knows
+// how deep the particle is and the surface's outward unit normal n there. Response (exercise
+// 5.1) puts the particle back on the surface and changes its velocity:
+//
+//   normal part      v_n = (v . n) n; if the particle is moving in (v . n < 0) it bounces back
+//                    with restitution e: v_n' = -e v_n  (e = 1 elastic, e = 0 no bounce)
+//   tangential part  v_t = v - v_n, resisted by Coulomb friction. The bounce is an impulse
+//                    j = (1 + e) |v . n| per unit mass; friction can take at most mu j from v_t:
+//                    static: if |v_t| <= mu_s j the particle sticks, v_t' = 0;
+//                    dynamic: otherwise it slides on, v_t' = v_t (1 - mu_d j / |v_t|).
+//
+// Friction only ever slows the sliding, never reverses it, so it cannot add energy. The
+// lecture's simpler version (reflect, v.y = -e v.y, v.x and v.z scaled by 1 - friction) is kept
+// beside it as model = "simple", so a lesson can compare the two.
+#pragma once
+
+#include "clothlab/core/effect.hpp"
+#include "clothlab/integrators/euler.hpp"
+
+namespace clothlab {
+
+// Exercise ex05.1: the response of a particle at r [m] with velocity v [m/s], found `depth` [m]
+// inside a solid whose outward unit normal at the contact is n: the particle is moved out by
+// depth along n, and its velocity is changed as above with restitution e and friction
+// coefficients mu_s (static) and mu_d (dynamic).
+PointState collision_response(const Vec3& r, const Vec3& v, const Vec3& n, double depth, double e,
+                              double mu_s, double mu_d);
+
+// The contact constants of a surface.
+struct ContactMaterial {
+  double e = 0.3;           // restitution, 0 to 1
+  double mu_s = 0.5;        // static friction coefficient
+  double mu_d = 0.4;        // dynamic friction coefficient (<= mu_s)
+  double rest_speed = 0.1;  // [m/s] slower approaches do not bounce: resting contact stays calm
+};
+
+// The ground plane y = y0, solid below.
+class Ground final : public PostStepEffect {
+ public:
+  enum class Model { coulomb, simple };
+  Ground(double y0, const ContactMaterial& material, Model model, double friction)
+      : y0_(y0), material_(material), model_(model), friction_(friction) {}
+  std::string_view name() const override { return "ground"; }
+  void apply(World& world, double dt) override;
+  // apply's loop on particles [begin, end) only: each particle is pushed out from its own state
+  // alone, so ranges may be taken apart (and by different threads at once).
+  void collide(Particles& p, Index begin, Index end) const;
+  double y0() const { return y0_; }
+
+ private:
+  double y0_;  // height of the ground [m]
+  ContactMaterial material_;
+  Model model_;
+  double friction_;  // the simple model's tangential loss per contact, 0 to 1
+};
+
+// A solid sphere the cloth can drape over.
+class Sphere final : public PostStepEffect {
+ public:
+  Sphere(const Vec3& centre, double radius, const ContactMaterial& material)
+      : centre_(centre), radius_(radius), material_(material) {}
+  std::string_view name() const override { return "sphere"; }
+  void apply(World& world, double dt) override;
+  // apply's loop on particles [begin, end) only (as Ground::collide).
+  void collide(Particles& p, Index begin, Index end) const;
+  const Vec3& centre() const { return centre_; }
+  double radius() const { return radius_; }
+
+ private:
+  Vec3 centre_;    // [m]
+  double radius_;  // [m]
+  ContactMaterial material_;
+};
+
+}  // namespace clothlab

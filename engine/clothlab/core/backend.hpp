@@ -1,0 +1,46 @@
+// backend.hpp: the one door between the lecture's engine and a faster one.
+//
+// The world steps the lecture's way (world.cpp): forces summed effect by effect, the integrator
+// moves the particles, the post-step effects apply, the guard checks. A backend may do some of
+// that work another way, with the same floating-point operations on every particle in the same
+// order, so that the state after a step is the same, bit for bit. The world asks it first and
+// takes its own path for whatever it declines. The engine's fast path (engine/fast/) is one; a
+// world without a backend (World::backend null, or `[engine] fast_path = false`) runs on the
+// lecture's code alone. Nothing in engine/clothlab/ knows more of a backend than this file says.
+#pragma once
+
+#include <cstddef>
+#include <string_view>
+
+#include "clothlab/core/types.hpp"
+
+namespace clothlab {
+
+class World;
+
+// What a backend took of a step (Backend::step).
+struct BackendStep {
+  // Steps 1-3 are done: the forces summed and every particle moved. The backend checked the
+  // state the step started from as it read it, and threw the guard's error before moving
+  // anything if that state was bad (Guard::check with before_step).
+  bool taken = false;
+  // The first this many post-step effects of the world's list are applied as well.
+  size_t post_step_done = 0;
+  // Every particle was found within the guard's bounds right after its last change in the step.
+  bool checked_after = false;
+};
+
+class Backend {
+ public:
+  virtual ~Backend() = default;
+
+  // f = the sum of every force effect of `world` at (x, v), as World::compute_forces_readable
+  // sums it, bit for bit. False: declined, f is untouched and the world sums it itself.
+  virtual bool sum_forces(const World& world, const Matrix3X& x, const Matrix3X& v,
+                          Matrix3X& f) = 0;
+
+  // Takes as much of one step of dt [s] as it can (see BackendStep); {} declines it all.
+  virtual BackendStep step(World& world, double dt) = 0;
+};
+
+}  // namespace clothlab

@@ -1,0 +1,93 @@
+// effect.hpp: the two kinds of effect a scene can switch on.
+//
+// Lecture, "Physics Simulation": 1. compute forces, 2. integrate motion, repeat.
+// A ForceEffect takes part in step 1 (gravity, springs, wind, ...). A PostStepEffect runs
+// once after the integrator has moved the particles (collisions, plasticity, tearing).
+// A scene constructs only the effects it names: an effect it does not name is never built,
+// so it costs nothing at all. The virtual call happens once per effect per force evaluation,
+// never once per particle.
+#pragma once
+
+#include <cmath>
+#include <string_view>
+
+#include "clothlab/core/particles.hpp"
+
+namespace clothlab {
+
+class World;
+
+using Mat3 = Eigen::Matrix3d;
+
+// Where an effect writes its force Jacobians for the implicit integrator (lesson 07): how its
+// forces change when positions (df/dx) and velocities (df/dv) change, as 3x3 blocks.
+class ForceJacobians {
+ public:
+  virtual ~ForceJacobians() = default;
+
+  // A force between i and j that is equal and opposite and depends on the differences
+  // x_j - x_i and v_j - v_i (a spring-damper). dfdx = df_i/dx_j and dfdv = df_i/dv_j, both
+  // symmetric; the other three blocks follow: df_i/dx_i = -dfdx, df_j/dx_i = dfdx,
+  // df_j/dx_j = -dfdx, and the same for dfdv.
+  virtual void add_pair(Index i, Index j, const Mat3& dfdx, const Mat3& dfdv) = 0;
+
+  // A force on particle i alone: dfdx = df_i/dx_i and dfdv = df_i/dv_i, both symmetric.
+  virtual void add_self(Index i, const Mat3& dfdx, const Mat3& dfdv) = 0;
+};
+
+class ForceEffect {
+ public:
+  virtual ~ForceEffect() = default;
+
+  // The effect's name as a scene writes it, e.g. "gravity"; used in reports and errors.
+  virtual std::string_view name() const = 0;
+
+  // Adds this effect's force on every particle into f [N], for positions x [m] and velocities
+  // v [m/s]. Multi-stage integrators call this at trial states, so an effect reads x and v from
+  // the arguments, never from p.x and p.v (p supplies masses and other per-particle data).
+  virtual void add_forces(const Particles& p, const Matrix3X& x, const Matrix3X& v,
+                          Matrix3X& f) const = 0;
+
+  // The potential energy this effect stores at positions x [J]; 0 for forces without one.
+  virtual double potential_energy(const Particles& /*p*/, const Matrix3X& /*x*/) const {
+    return 0.0;
+  }
+
+  // The energy [J] this effect can give the particles, as a yardstick for the guard's
+  // energy-runaway check: for a conservative force the energy it stores at x, |U(x)|; a force
+  // that can feed energy in (gravity over the scene's size, wind) says how much. `size` [m] is
+  // the diagonal of the particles' bounding box.
+  virtual double energy_scale(const Particles& p, const Matrix3X& x, double /*size*/) const {
+    return std::abs(potential_energy(p, x));
+  }
+
+  // The energy [J] an external field (gravity, gravitation, buoyancy) has released between
+  // positions x0 and x, |U(x) - U(x0)|: a ball that has fallen far has that much energy to
+  // show for it. Springs and other internal forces release none: their energy is what a
+  // runaway shows up in. The guard widens its yardstick by the most released so far.
+  virtual double released_energy(const Particles& /*p*/, const Matrix3X& /*x0*/,
+                                 const Matrix3X& /*x*/) const {
+    return 0.0;
+  }
+
+  // Adds this effect's force Jacobians at (x, v) for the implicit integrator. An effect that
+  // adds none (gravity, wind) is treated explicitly: its force enters the step, its Jacobian
+  // does not. Returns whether it added any.
+  virtual bool add_jacobians(const Particles& /*p*/, const Matrix3X& /*x*/, const Matrix3X& /*v*/,
+                             ForceJacobians& /*jacobians*/) const {
+    return false;
+  }
+};
+
+class PostStepEffect {
+ public:
+  virtual ~PostStepEffect() = default;
+  virtual std::string_view name() const = 0;
+
+  // Applies the effect once the integrator has advanced the particles by dt [s]. It gets the
+  // whole world: some post-step effects change more than particles (tearing removes springs
+  // and triangles).
+  virtual void apply(World& world, double dt) = 0;
+};
+
+}  // namespace clothlab

@@ -1,0 +1,101 @@
+// world.hpp: the particles, the effects a scene named, and the step that ties them together.
+//
+// One step, in the lecture's order:
+//   1. clear the force accumulators;
+//   2. every force effect adds its forces;
+//   3. the integrator advances positions and velocities (re-evaluating 1-2 if it needs to);
+//   4. every post-step effect applies (collisions, plasticity, tearing);
+//   5. the guard checks that the state is still finite and bounded (and it checked it before 1).
+// A backend (backend.hpp) may take some of it another way, with the same result, bit for bit.
+#pragma once
+
+#include <functional>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "clothlab/core/backend.hpp"
+#include "clothlab/core/effect.hpp"
+#include "clothlab/core/guard.hpp"
+#include "clothlab/core/particles.hpp"
+#include "clothlab/core/threads.hpp"
+#include "clothlab/core/triangles.hpp"
+#include "clothlab/integrators/integrator.hpp"
+
+namespace clothlab {
+
+// Wall time spent in each part of the step, filled in when World::timing points at it. Force
+// effects and post-step effects are listed in the world's order.
+struct StepTimes {
+  std::vector<double> force_effects;      // [s] each force effect, in the sums the world made
+  std::vector<double> post_step_effects;  // [s] each post-step effect the world applied
+  double integrator = 0.0;                // [s] the integrator's own work, forces excluded
+  double guard = 0.0;                     // [s] the guard's checks
+  double backend_forces = 0.0;            // [s] force sums the backend made, every effect at once
+  double backend_steps = 0.0;             // [s] what the backend took of the steps (BackendStep)
+};
+
+class World {
+ public:
+  Particles particles;
+  std::vector<Triangle> triangles;  // the cloth's surface (lesson 03), for effects and output
+  std::vector<std::unique_ptr<ForceEffect>> force_effects;
+  std::vector<std::unique_ptr<PostStepEffect>> post_step_effects;
+  std::unique_ptr<Integrator> integrator;
+  Guard guard;
+  // What may take force sums or whole steps the fast way (backend.hpp); null: none, every step
+  // runs on the lecture's code. A scene gets the engine's fast path unless it says
+  // `[engine] fast_path = false`.
+  std::unique_ptr<Backend> backend;
+
+  double t = 0.0;  // simulated time [s]
+  long steps = 0;  // steps taken so far
+
+  // How often compute_forces has run: what a multi-stage integrator pays per step.
+  mutable long force_evaluations = 0;
+  mutable long fast_evaluations = 0;  // how many of them the backend made
+
+  // When set (by `clothlab run --stats`), each step adds the time of each of its parts here,
+  // on whichever path it takes. The check costs one branch per part, never one per particle.
+  StepTimes* timing = nullptr;
+
+  // Threads a step may use (the backend, the guard); 1: this one only. ([engine] threads in a
+  // scene, `clothlab run --threads N`.)
+  int threads = 1;
+
+  // Takes one step of dt [s] (steps 1-5 above).
+  void step(double dt);
+
+  // Steps 1-2 at an arbitrary state: f = sum of every force effect at (x, v) [N]. The backend
+  // sums them when it can; else the lecture's loop below does. Both give the same f, bit for bit.
+  void compute_forces(const Matrix3X& x, const Matrix3X& v, Matrix3X& f) const;
+
+  // The lecture's loop, the one the lessons show: clear f, then each effect adds its forces.
+  void compute_forces_readable(const Matrix3X& x, const Matrix3X& v, Matrix3X& f) const;
+
+  // Calls range(begin, end) on contiguous ranges of particles that cover them all once, each
+  // range on one of the `threads` threads: for loops over particles whose iterations are
+  // independent (the guard's checks, a backend's passes).
+  void for_particles(const std::function<void(Index begin, Index end)>& range) const;
+
+  // Diagnostics of the current state.
+  double kinetic_energy() const;    // sum of 1/2 m |v|^2 [J] (pinned particles do not move)
+  double potential_energy() const;  // sum over force effects [J]
+  Vec3 momentum() const;            // sum of m v [kg m/s]
+
+  // "gravity, gravitation; symplectic-euler": what a report or an error names as in play.
+  std::string effects_in_play() const;
+
+ private:
+  // The parts of step(), each timed when timing is set.
+  BackendStep backend_step(double dt);  // what the backend takes of it
+  void check(bool before_step) const;   // the guard's check of the state
+  void advance(double dt);              // the integrator's advance
+  void apply(size_t k, double dt);      // post-step effect k
+
+  ThreadTeam* team() const;  // the threads of a step, or null for one thread
+
+  mutable std::unique_ptr<ThreadTeam> team_;
+};
+
+}  // namespace clothlab

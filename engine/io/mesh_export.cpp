@@ -1,0 +1,127 @@
+#include "io/mesh_export.hpp"
+
+#include <fstream>
+#include <stdexcept>
+
+#include <fmt/format.h>
+
+#include "clothlab/forces/spring_damper.hpp"
+#include "io/output.hpp"
+
+namespace clothlab {
+
+namespace {
+
+// Every spring of the world's spring effects, as (i, j, l0).
+struct SpringView {
+  Index i, j;
+  double l0;
+};
+std::vector<SpringView> all_springs(const World& world) {
+  std::vector<SpringView> springs;
+  for (const auto& effect : world.force_effects) {
+    if (const auto* s = dynamic_cast<const SpringDampers*>(effect.get())) {
+      const SpringSet& set = s->springs();
+      for (size_t k = 0; k < set.size(); ++k)
+        springs.push_back({set.i(k), set.j(k), set.l0(k)});
+    }
+  }
+  return springs;
+}
+
+}  // namespace
+
+Matrix3X vertex_normals(const Matrix3X& x, const std::vector<Triangle>& triangles) {
+  Matrix3X normals;
+  vertex_normals(x, triangles, normals);
+  return normals;
+}
+
+void vertex_normals(const Matrix3X& x, const std::vector<Triangle>& triangles, Matrix3X& normals) {
+  normals.setZero(3, x.cols());
+  for (const Triangle& t : triangles) {
+    const Vec3 n_star = (x.col(t[1]) - x.col(t[0])).cross(x.col(t[2]) - x.col(t[0]));
+    for (Index i : t)
+      normals.col(i) += n_star;
+  }
+  for (Index i = 0; i < normals.cols(); ++i) {
+    const double length = normals.col(i).norm();
+    if (length > 0.0) normals.col(i) /= length;
+  }
+}
+
+MeshExporter::MeshExporter(const std::filesystem::path& dir, bool obj, bool vtk)
+    : dir_(dir), obj_(obj), vtk_(vtk) {
+  if (obj_ || vtk_) std::filesystem::create_directories(dir_);
+}
+
+void MeshExporter::write(const World& world, long frame) {
+  const Matrix3X& x = world.particles.x;
+  const std::string stem = fmt::format("frame_{:04}", frame);
+  const std::vector<SpringView> springs = all_springs(world);
+  if (obj_) {
+    std::ofstream out = open_for_writing(dir_ / (stem + ".obj"));
+    out << fmt::format("# clothlab frame {} at t = {} s\n", frame, world.t);
+    for (Index i = 0; i < x.cols(); ++i) {
+      out << fmt::format("v {} {} {}\n", x(0, i), x(1, i), x(2, i));
+    }
+    if (!world.triangles.empty()) {
+      const Matrix3X n = vertex_normals(x, world.triangles);
+      for (Index i = 0; i < n.cols(); ++i) {
+        out << fmt::format("vn {} {} {}\n", n(0, i), n(1, i), n(2, i));
+      }
+      // OBJ counts from 1; "a//a" gives vertex a its own normal a.
+      for (const Triangle& t : world.triangles) {
+        out << fmt::format("f {0}//{0} {1}//{1} {2}//{2}\n", t[0] + 1, t[1] + 1, t[2] + 1);
+      }
+    } else {
+      for (const SpringView& s : springs)
+        out << fmt::format("l {} {}\n", s.i + 1, s.j + 1);
+    }
+    if (!out) throw std::runtime_error("writing an OBJ frame failed");
+  }
+  if (vtk_) {
+    const std::string name = stem + ".vtk";
+    std::ofstream out = open_for_writing(dir_ / name);
+    const Matrix3X& v = world.particles.v;
+    out << "# vtk DataFile Version 3.0\n"
+        << fmt::format("clothlab frame {} t = {}\n", frame, world.t) << "ASCII\nDATASET POLYDATA\n"
+        << fmt::format("POINTS {} double\n", x.cols());
+    for (Index i = 0; i < x.cols(); ++i)
+      out << fmt::format("{} {} {}\n", x(0, i), x(1, i), x(2, i));
+    // Cells in VTK's order, lines (the springs) before polygons (the triangles).
+    out << fmt::format("LINES {} {}\n", springs.size(), 3 * springs.size());
+    for (const SpringView& s : springs)
+      out << fmt::format("2 {} {}\n", s.i, s.j);
+    out << fmt::format("POLYGONS {} {}\n", world.triangles.size(), 4 * world.triangles.size());
+    for (const Triangle& t : world.triangles)
+      out << fmt::format("3 {} {} {}\n", t[0], t[1], t[2]);
+    // Strain of each spring, l / l0 - 1 (0 at rest, 0.1 = stretched by 10 %); triangles get 0.
+    out << fmt::format("CELL_DATA {}\nSCALARS strain double 1\nLOOKUP_TABLE default\n",
+                       springs.size() + world.triangles.size());
+    for (const SpringView& s : springs) {
+      const double l = (x.col(s.j) - x.col(s.i)).norm();
+      out << fmt::format("{}\n", s.l0 > 0.0 ? l / s.l0 - 1.0 : 0.0);
+    }
+    for (size_t k = 0; k < world.triangles.size(); ++k)
+      out << "0\n";
+    out << fmt::format("POINT_DATA {}\nVECTORS velocity double\n", x.cols());
+    for (Index i = 0; i < v.cols(); ++i)
+      out << fmt::format("{} {} {}\n", v(0, i), v(1, i), v(2, i));
+    if (!out) throw std::runtime_error("writing a VTK frame failed");
+    vtk_files_.emplace_back(name, world.t);
+  }
+}
+
+void MeshExporter::finish() const {
+  if (!vtk_) return;
+  std::ofstream out = open_for_writing(dir_ / "frames.vtk.series");
+  out << "{\n  \"file-series-version\": \"1.0\",\n  \"files\": [\n";
+  for (size_t k = 0; k < vtk_files_.size(); ++k) {
+    out << fmt::format("    {{\"name\": \"{}\", \"time\": {}}}{}\n", vtk_files_[k].first,
+                       vtk_files_[k].second, k + 1 < vtk_files_.size() ? "," : "");
+  }
+  out << "  ]\n}\n";
+}
+
+}  // namespace clothlab

@@ -1,0 +1,42 @@
+// mesh_export.hpp: frames as standard mesh files, for Blender and ParaView.
+//
+//   OBJ sequence   frame_0001.obj, frame_0002.obj, ...: vertices, per-vertex normals and the
+//                  cloth's triangles (or the springs as lines when there are no triangles).
+//                  Blender imports a sequence with a mesh-sequence add-on; any viewer opens one.
+//   VTK series     frame_0001.vtk, ... (legacy VTK polydata) with per-vertex velocity and
+//                  per-spring strain (l / l0 - 1), indexed by frames.vtk.series with the time of
+//                  each file, which ParaView opens as one animated data set.
+#pragma once
+
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "clothlab/core/world.hpp"
+
+namespace clothlab {
+
+class MeshExporter {
+ public:
+  // Writes into `dir` (created if needed) the formats asked for.
+  MeshExporter(const std::filesystem::path& dir, bool obj, bool vtk);
+
+  // Writes the world's current state as frame number `frame` (numbered from 1 in file names).
+  void write(const World& world, long frame);
+
+  // Writes the VTK series index; call once at the end (also after an early stop).
+  void finish() const;
+
+ private:
+  std::filesystem::path dir_;
+  bool obj_, vtk_;
+  std::vector<std::pair<std::string, double>> vtk_files_;  // name and time [s]
+};
+
+// Per-vertex normals: the area-weighted average of the normals of the triangles around each
+// vertex (the cross product's length is twice the area, so plain sums weight by area).
+Matrix3X vertex_normals(const Matrix3X& x, const std::vector<Triangle>& triangles);
+// The same into `normals`, resized to 3 x N: no allocation when it has that size already.
+void vertex_normals(const Matrix3X& x, const std::vector<Triangle>& triangles, Matrix3X& normals);
+
+}  // namespace clothlab

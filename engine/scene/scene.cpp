@@ -1,0 +1,494 @@
+#include "scene/scene.hpp"
+
+#include <algorithm>
+#include <cctype>
+#include <cmath>
+#include <fstream>
+#include <sstream>
+#include <vector>
+
+#include <fmt/format.h>
+#include <toml++/toml.h>
+
+#include "fast/engine.hpp"
+#include "scene/scene_reader.hpp"
+#include "scene/scene_tables.hpp"
+
+namespace clothlab {
+
+SceneError::SceneError(const std::string& source, long line, long column,
+                       const std::string& message)
+    : std::runtime_error(fmt::format("{}:{}:{}: {}", source, line, column, message)),
+      source_(source),
+      line_(line),
+      column_(column),
+      message_(message) {}
+
+long Scene::step_count() const {
+  // duration / dt rounded to the nearest whole step (1.0 / 0.01 is 100.00000000000001).
+  return std::max(1L, std::lround(duration / dt));
+}
+
+namespace {
+
+const toml::table& as_table(const void* node) {
+  return *static_cast<const toml::table*>(node);
+}
+
+[[noreturn]] void fail_at(const std::string& source, const toml::source_region& where,
+                          const std::string& message) {
+  throw SceneError(source, static_cast<long>(where.begin.line),
+                   static_cast<long>(where.begin.column), message);
+}
+
+std::string_view type_name(const toml::node& node) {
+  switch (node.type()) {
+    case toml::node_type::string:
+      return "a string";
+    case toml::node_type::integer:
+      return "an integer";
+    case toml::node_type::floating_point:
+      return "a number";
+    case toml::node_type::boolean:
+      return "a boolean";
+    case toml::node_type::array:
+      return "an array";
+    case toml::node_type::table:
+      return "a table";
+    default:
+      return "a date or time";
+  }
+}
+
+// Calls fn(name) for each name in a list separated by spaces.
+template <class Fn>
+void for_each_name(std::string_view names, Fn fn) {
+  while (!names.empty()) {
+    const size_t end = std::min(names.find(' '), names.size());
+    if (end > 0) fn(names.substr(0, end));
+    names.remove_prefix(std::min(end + 1, names.size()));
+  }
+}
+
+bool is_one_of(std::string_view name, std::string_view names) {
+  bool found = false;
+  for_each_name(names, [&](std::string_view n) { found = found || n == name; });
+  return found;
+}
+
+std::string comma_list(std::string_view names) {
+  std::string list;
+  for_each_name(names, [&](std::string_view n) {
+    if (!list.empty()) list += ", ";
+    list += n;
+  });
+  return list;
+}
+
+std::string describe_range(const Range& r) {
+  std::string text;
+  const bool has_min = std::isfinite(r.min);
+  const bool has_max = std::isfinite(r.max);
+  if (has_min && has_max) {
+    text = r.min_exclusive ? fmt::format("a number > {} and <= {}", r.min, r.max)
+                           : fmt::format("a number from {} to {}", r.min, r.max);
+  } else if (has_min) {
+    text = fmt::format("a number {} {}", r.min_exclusive ? ">" : ">=", r.min);
+  } else {
+    text = "a finite number";
+  }
+  if (!r.unit.empty()) text += fmt::format(" [{}]", r.unit);
+  return text;
+}
+
+}  // namespace
+
+// --- SceneTable ------------------------------------------------------------------------------
+
+SceneTable::SceneTable(const void* node, std::string display_name, const std::string& source)
+    : node_(node), name_(std::move(display_name)), source_(source) {}
+
+void SceneTable::fail(std::string_view key, const std::string& message) const {
+  const toml::table& table = as_table(node_);
+  const toml::node* value = table.get(key);
+  fail_at(source_, value ? value->source() : table.source(), message);
+}
+
+namespace {
+
+// Reads one number from `node`, checking type, finiteness and range.
+double checked_number(const toml::node& node, const std::string& source, std::string_view what,
+                      const Range& range) {
+  double x = 0.0;
+  if (const auto* i = node.as_integer()) {
+    x = static_cast<double>(i->get());
+  } else if (const auto* d = node.as_floating_point()) {
+    x = d->get();
+  } else {
+    fail_at(source, node.source(),
+            fmt::format("{} is {}; expected {}", what, type_name(node), describe_range(range)));
+  }
+  if (!std::isfinite(x)) {
+    fail_at(source, node.source(),
+            fmt::format("{} is {}; expected {}", what, x, describe_range(range)));
+  }
+  const bool below = range.min_exclusive ? !(x > range.min) : !(x >= range.min);
+  if (below || x > range.max) {
+    fail_at(source, node.source(),
+            fmt::format("{} is {}; expected {}", what, x, describe_range(range)));
+  }
+  return x;
+}
+
+}  // namespace
+
+double SceneTable::number(std::string_view key, const Range& range, double fallback) {
+  const toml::node* node = as_table(node_).get(key);
+  if (!node) return fallback;
+  return checked_number(*node, source_, fmt::format("'{}' in {}", key, name_), range);
+}
+
+double SceneTable::required_number(std::string_view key, const Range& range) {
+  if (!as_table(node_).contains(key)) {
+    fail(key,
+         fmt::format("{} has no '{}'; expected {} = {}", name_, key, key, describe_range(range)));
+  }
+  return number(key, range, 0.0);
+}
+
+Vec3 SceneTable::vec3(std::string_view key, std::string_view unit, const Vec3& fallback) {
+  const toml::node* node = as_table(node_).get(key);
+  if (!node) return fallback;
+  const toml::array* array = node->as_array();
+  const std::string expected = fmt::format("an array of three numbers [x, y, z] [{}]", unit);
+  if (!array) {
+    fail_at(source_, node->source(),
+            fmt::format("'{}' in {} is {}; expected {}", key, name_, clothlab::type_name(*node),
+                        expected));
+  }
+  if (array->size() != 3) {
+    fail_at(source_, node->source(),
+            fmt::format("'{}' in {} has {} elements; expected {}", key, name_, array->size(),
+                        expected));
+  }
+  Vec3 result;
+  for (int k = 0; k < 3; ++k) {
+    result[k] = checked_number((*array)[static_cast<size_t>(k)], source_,
+                               fmt::format("'{}[{}]' in {}", key, k, name_), Range::any(unit));
+  }
+  return result;
+}
+
+Vec3 SceneTable::required_vec3(std::string_view key, std::string_view unit) {
+  if (!as_table(node_).contains(key)) {
+    fail(key, fmt::format("{} has no '{}'; expected {} = [x, y, z] [{}]", name_, key, key, unit));
+  }
+  return vec3(key, unit, Vec3::Zero());
+}
+
+namespace {
+
+long checked_integer(const toml::node& node, const std::string& source, std::string_view what,
+                     long min, long max) {
+  const auto* i = node.as_integer();
+  if (const auto* d = node.as_floating_point()) {
+    // "rows = 3.0" is a floating-point number in TOML; name it as written, with its point.
+    std::string value = fmt::format("{}", d->get());
+    if (value.find_first_of(".eni") == std::string::npos) value += ".0";
+    fail_at(source, node.source(),
+            fmt::format("{} is {}, not a whole number; expected a whole number from {} to {} "
+                        "(written without a decimal point)",
+                        what, value, min, max));
+  }
+  if (!i) {
+    fail_at(source, node.source(),
+            fmt::format("{} is {}; expected a whole number from {} to {}", what, type_name(node),
+                        min, max));
+  }
+  const long value = static_cast<long>(i->get());
+  if (value < min || value > max) {
+    fail_at(source, node.source(),
+            fmt::format("{} is {}; expected a whole number from {} to {}", what, value, min, max));
+  }
+  return value;
+}
+
+}  // namespace
+
+long SceneTable::integer(std::string_view key, long min, long max, long fallback) {
+  const toml::node* node = as_table(node_).get(key);
+  if (!node) return fallback;
+  return checked_integer(*node, source_, fmt::format("'{}' in {}", key, name_), min, max);
+}
+
+long SceneTable::required_integer(std::string_view key, long min, long max) {
+  if (!has(key)) {
+    fail(key, fmt::format("{} has no '{}'; expected {} = a whole number from {} to {}", name_, key,
+                          key, min, max));
+  }
+  return integer(key, min, max, 0);
+}
+
+std::vector<long> SceneTable::integer_list(std::string_view key, long min, long max,
+                                           std::string_view what) {
+  std::vector<long> values;
+  const toml::node* node = as_table(node_).get(key);
+  if (!node) return values;
+  const toml::array* array = node->as_array();
+  if (!array) {
+    fail_at(source_, node->source(),
+            fmt::format("'{}' in {} is {}; expected an array of whole numbers from {} to {}", key,
+                        name_, clothlab::type_name(*node), min, max));
+  }
+  for (size_t k = 0; k < array->size(); ++k) {
+    values.push_back(checked_integer(
+        (*array)[k], source_, fmt::format("{} '{}[{}]' in {}", what, key, k, name_), min, max));
+  }
+  return values;
+}
+
+bool SceneTable::boolean(std::string_view key, bool fallback) {
+  const toml::node* node = as_table(node_).get(key);
+  if (!node) return fallback;
+  if (const auto* b = node->as_boolean()) return b->get();
+  fail_at(source_, node->source(),
+          fmt::format("'{}' in {} is {}; expected true or false", key, name_,
+                      clothlab::type_name(*node)));
+}
+
+bool SceneTable::has(std::string_view key) const {
+  return as_table(node_).contains(key);
+}
+
+bool SceneTable::is_string(std::string_view key) const {
+  const toml::node* node = as_table(node_).get(key);
+  return node && node->is_string();
+}
+
+bool SceneTable::is_array(std::string_view key) const {
+  const toml::node* node = as_table(node_).get(key);
+  return node && node->is_array();
+}
+
+std::string_view SceneTable::type_name(std::string_view key) const {
+  const toml::node* node = as_table(node_).get(key);
+  return node ? clothlab::type_name(*node) : "missing";
+}
+
+std::optional<std::string> SceneTable::string(std::string_view key) {
+  const toml::node* node = as_table(node_).get(key);
+  if (!node) return std::nullopt;
+  if (const auto* s = node->as_string()) return s->get();
+  fail_at(
+      source_, node->source(),
+      fmt::format("'{}' in {} is {}; expected a string", key, name_, clothlab::type_name(*node)));
+}
+
+std::string SceneTable::choice(std::string_view key, const std::vector<std::string_view>& choices,
+                               std::string_view fallback) {
+  const std::optional<std::string> value = string(key);
+  if (!value) return std::string(fallback);
+  for (std::string_view c : choices) {
+    if (*value == c) return *value;
+  }
+  fail(key, fmt::format("unknown {} '{}' in {}; expected one of: \"{}\"", key, *value, name_,
+                        fmt::join(choices, "\", \"")));
+}
+
+void SceneTable::check_keys(std::string_view known) const {
+  for (auto&& [key, value] : as_table(node_)) {
+    if (is_one_of(key.str(), known)) continue;
+    const std::string guess = nearest_name(key.str(), known);
+    fail_at(source_, key.source(),
+            fmt::format("unknown key '{}' in {}{}; expected one of: {}", key.str(), name_,
+                        guess.empty() ? "" : fmt::format(" (did you mean '{}'?)", guess),
+                        comma_list(known)));
+  }
+}
+
+std::string nearest_name(std::string_view typo, std::string_view candidates) {
+  // Levenshtein distance: the fewest single-letter edits that turn one word into the other.
+  auto distance = [](std::string_view a, std::string_view b) {
+    std::vector<size_t> row(b.size() + 1);
+    for (size_t j = 0; j <= b.size(); ++j)
+      row[j] = j;
+    for (size_t i = 1; i <= a.size(); ++i) {
+      size_t diagonal = row[0];
+      row[0] = i;
+      for (size_t j = 1; j <= b.size(); ++j) {
+        const size_t substitute = diagonal + (a[i - 1] == b[j - 1] ? 0 : 1);
+        diagonal = row[j];
+        row[j] = std::min({row[j] + 1, row[j - 1] + 1, substitute});
+      }
+    }
+    return row[b.size()];
+  };
+  std::string best;
+  size_t best_distance = 3;  // more than two edits away is no longer a typo
+  for_each_name(candidates, [&](std::string_view name) {
+    const size_t d = distance(typo, name);
+    if (d < best_distance) {
+      best_distance = d;
+      best = name;
+    }
+  });
+  return best;
+}
+
+// --- Reading a whole scene -------------------------------------------------------------------
+
+namespace {
+
+// The text from LINE:COLUMN (1-based, columns counting characters as toml++ does) to the end of
+// its line, or "" past the end of the text.
+std::string_view rest_of_line(std::string_view text, const toml::source_position& at) {
+  size_t k = 0;
+  for (toml::source_index line = 1; line < at.line; ++line) {
+    k = text.find('\n', k);
+    if (k == std::string_view::npos) return {};
+    ++k;
+  }
+  for (toml::source_index column = 1; column < at.column && k < text.size(); ++column) {
+    ++k;  // one character: its first byte and any UTF-8 continuation bytes (10xxxxxx)
+    while (k < text.size() && (static_cast<unsigned char>(text[k]) & 0xC0) == 0x80)
+      ++k;
+  }
+  const std::string_view rest = text.substr(std::min(k, text.size()));
+  return rest.substr(0, rest.find_first_of("\r\n"));
+}
+
+// A toml++ syntax error in the reader's words. toml++ says e.g. "Error while parsing array:
+// expected comma or closing ']', saw 'm'", which already names what was expected; the mistakes
+// whose wording is cryptic (an unclosed string, a key given twice, a word without quotes) are
+// said here instead, and anything else gets an "expected" if it has none.
+std::string explain_toml_error(std::string_view text, const toml::parse_error& error) {
+  const std::string_view d = error.description();
+  const toml::source_position at = error.source().begin;
+  constexpr auto npos = std::string_view::npos;
+
+  // An unclosed string: toml++ stops at the newline (a control character) or the end of file.
+  if (d.find("parsing string") != npos || d.find("parsing literal string") != npos) {
+    if (d.find("end-of-file") != npos) {
+      return "the string is not closed before the end of the file; expected a closing quote";
+    }
+    if (d.find("control characters") != npos && rest_of_line(text, at).empty()) {
+      return "the string is not closed on its line; expected a closing quote before the end of "
+             "the line";
+    }
+  }
+  // "cannot redefine existing table 'gravity'", "cannot redefine existing integer 'rows'".
+  if (const size_t k = d.find("cannot redefine existing "); k != npos) {
+    const size_t open = d.find('\'', k);
+    const size_t close = open == npos ? npos : d.find('\'', open + 1);
+    if (close != npos) {
+      const std::string_view name = d.substr(open + 1, close - open - 1);
+      if (d.substr(k).starts_with("cannot redefine existing table")) {
+        return fmt::format(
+            "[{}] is defined twice; expected each table once ([[{}]] for a table "
+            "that repeats, one per item)",
+            name, name);
+      }
+      return fmt::format("'{}' is given twice; expected each key once in a table", name);
+    }
+  }
+  // mass = heavy: a word where a value belongs, usually a string without its quotes.
+  if (d.find("could not determine value type") != npos) {
+    std::string_view word = rest_of_line(text, at);
+    word = word.substr(0, std::min(word.find_first_of(" \t,]}#"), size_t{40}));
+    return fmt::format(
+        "'{}' is not a value; expected a number, a \"quoted string\", true, false "
+        "or an array",
+        word);
+  }
+  std::string what(d);
+  if (!what.empty()) what[0] = static_cast<char>(std::tolower(static_cast<unsigned char>(what[0])));
+  if (d.find("could not be interpreted as a value") != npos) {
+    what += "; expected a number between -1.8e308 and 1.8e308";
+  } else if (d.find("not representable in 64 bits") != npos) {
+    what += "; expected a whole number between -9223372036854775808 and 9223372036854775807";
+  } else if (d.find("expected") == npos) {
+    what += "; expected valid TOML";
+  }
+  return what;
+}
+
+}  // namespace
+
+Scene parse_scene(std::string_view text, const std::string& source) {
+  toml::table root;
+  try {
+    root = toml::parse(text, source);
+  } catch (const toml::parse_error& error) {
+    fail_at(source, error.source(), "invalid TOML: " + explain_toml_error(text, error));
+  }
+
+  Scene scene;
+  scene.source = source;
+  const toml::source_region top{{1, 1}, {1, 1}, nullptr};
+
+  // Every top-level key is a table this build knows, or the scene's title.
+  for (auto&& [key, value] : root) {
+    if (key.str() == "title") {
+      if (!value.is_string()) {
+        fail_at(source, value.source(),
+                fmt::format("'title' is {}; expected a string", type_name(value)));
+      }
+      scene.title = value.as_string()->get();
+      continue;
+    }
+    const SceneTableKind* kind = find_scene_table(key.str());
+    if (!kind) {
+      const std::string guess = nearest_name(key.str(), scene_table_names());
+      fail_at(source, key.source(),
+              fmt::format("unknown table [{}]{}; expected one of: {}", key.str(),
+                          guess.empty() ? "" : fmt::format(" (did you mean [{}]?)", guess),
+                          comma_list(scene_table_names())));
+    }
+    const bool is_array_of_tables = value.is_array_of_tables();
+    if (kind->repeated ? !is_array_of_tables : !value.is_table()) {
+      fail_at(source, value.source(),
+              kind->repeated ? fmt::format("'{}' is {}; expected one or more [[{}]] tables",
+                                           key.str(), type_name(value), key.str())
+                             : fmt::format("'{}' is {}; expected a [{}] table", key.str(),
+                                           type_name(value), key.str()));
+    }
+  }
+
+  // The engine's fast path, unless [engine] says fast_path = false.
+  scene.world.backend = fast::make_fast_engine();
+  // Read the tables in the order the engine needs them (particles before the effects on them).
+  for (const SceneTableKind& kind : scene_table_kinds()) {
+    const toml::node* node = root.get(kind.name);
+    if (!node) {
+      if (kind.required) {
+        fail_at(source, top,
+                fmt::format("the scene has no [{}] table; expected {}", kind.name, kind.summary));
+      }
+      continue;
+    }
+    if (kind.repeated) {
+      const toml::array& array = *node->as_array();
+      for (size_t i = 0; i < array.size(); ++i) {
+        SceneTable table(array[i].as_table(), fmt::format("[[{}]] #{}", kind.name, i + 1), source);
+        table.check_keys(kind.keys);
+        kind.read(table, scene);
+      }
+    } else {
+      SceneTable table(node->as_table(), fmt::format("[{}]", kind.name), source);
+      table.check_keys(kind.keys);
+      kind.read(table, scene);
+    }
+  }
+  finish_scene(scene, [&](const std::string& message) { fail_at(source, top, message); });
+  return scene;
+}
+
+Scene load_scene_file(const std::filesystem::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw SceneError(path.string(), 1, 1, "cannot open the file; expected a readable scene");
+  std::ostringstream text;
+  text << in.rdbuf();
+  return parse_scene(text.str(), path.string());
+}
+
+}  // namespace clothlab

@@ -1,0 +1,66 @@
+// scene.hpp: a scene file, read into a world ready to step.
+//
+// A scene is a TOML file. Each table names one effect or part ([gravity], [integrator], ...);
+// a table that is present is simulated, one that is absent is never constructed. Anything the
+// reader does not understand is an error of the form
+//   FILE:LINE:COL: what is wrong; what was expected
+// raised before anything is simulated or written.
+#pragma once
+
+#include <filesystem>
+#include <optional>
+#include <stdexcept>
+#include <string>
+#include <string_view>
+
+#include "clothlab/bodies/cloth.hpp"
+#include "clothlab/bodies/rope.hpp"
+#include "clothlab/bodies/solid.hpp"
+#include "clothlab/core/world.hpp"
+#include "clothlab/forces/spring_damper.hpp"
+
+namespace clothlab {
+
+class SceneError : public std::runtime_error {
+ public:
+  SceneError(const std::string& source, long line, long column, const std::string& message);
+  const std::string& source() const { return source_; }
+  long line() const { return line_; }
+  long column() const { return column_; }
+  const std::string& message() const { return message_; }
+
+ private:
+  std::string source_;
+  long line_;
+  long column_;
+  std::string message_;
+};
+
+struct OutputSettings {
+  double fps = 30.0;  // frames written per simulated second [1/s]
+};
+
+struct Scene {
+  std::string source;  // the file name errors and reports use
+  std::string title;   // optional `title = "..."` at the top of the file
+  World world;
+  double dt = 0.0;        // time step [s]
+  double duration = 0.0;  // simulated time [s]
+  OutputSettings output;
+
+  // What the builders made, for the tables read after them (springs, bending, aerodynamics).
+  std::optional<ClothGrid> cloth;
+  std::optional<Rope> rope;
+  std::optional<SolidLattice> solid;
+  SpringSet springs;  // structural, shear and one-by-one springs: the "springs" effect
+
+  long step_count() const;  // steps needed to cover `duration`
+};
+
+// Reads the scene file at `path`. Throws SceneError.
+Scene load_scene_file(const std::filesystem::path& path);
+
+// Reads a scene from `text`; `source` names it in errors (a path, or e.g. "<demo>").
+Scene parse_scene(std::string_view text, const std::string& source);
+
+}  // namespace clothlab

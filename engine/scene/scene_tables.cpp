@@ -1,0 +1,633 @@
+#include "scene/scene_tables.hpp"
+
+#include <array>
+#include <cmath>
+#include <limits>
+#include <vector>
+
+#include <fmt/format.h>
+
+#include "clothlab/after_step/ground_collision.hpp"
+#include "clothlab/after_step/plasticity.hpp"
+#include "clothlab/after_step/self_collision.hpp"
+#include "clothlab/after_step/strain_limiting.hpp"
+#include "clothlab/after_step/tearing.hpp"
+#include "clothlab/bodies/solid.hpp"
+#include "clothlab/forces/aerodynamics.hpp"
+#include "clothlab/forces/bending.hpp"
+#include "clothlab/forces/damping.hpp"
+#include "clothlab/forces/gravitation.hpp"
+#include "clothlab/forces/gravity.hpp"
+#include "clothlab/integrators/implicit_euler.hpp"
+
+namespace clothlab {
+
+namespace {
+
+// The smallest mass a particle may have [kg]: the engine divides by it (inv_m = 1/m), and below
+// the smallest normal double, 2.2e-308, the inverse overflows to infinity.
+constexpr double kMinParticleMass = std::numeric_limits<double>::min();
+
+// Refuses a share of mass too small to divide by; `what` says where the share came from.
+void check_particle_mass(SceneTable& t, std::string_view key, double m, const std::string& what) {
+  if (m < kMinParticleMass) {
+    t.fail(key, fmt::format("{} is {} kg, too small to divide by; expected at least {:.2g} kg a "
+                            "particle",
+                            what, m, kMinParticleMass));
+  }
+}
+
+// The guard stops a run at its first step if a particle starts beyond its bounds, so such a scene
+// is refused here, where the line can be named; this also keeps a huge spacing or coordinate from
+// overflowing to infinity. [guard] is read before any particle.
+void check_within_guard(SceneTable& t, std::string_view key, const Scene& scene, Index i,
+                        std::string_view what) {
+  const double bound = scene.world.guard.max_position;
+  const Vec3 x = scene.world.particles.x.col(i);
+  // !(|x| <= bound) also catches an infinity, as in Guard::check.
+  if (!(x.array().abs() <= bound).all()) {
+    t.fail(key, fmt::format("{} starts at ({}, {}, {}) m, beyond the guard's max_position = {} m; "
+                            "expected |x|, |y|, |z| <= {} m (a larger max_position in [guard] "
+                            "allows more)",
+                            what, x.x(), x.y(), x.z(), bound, bound));
+  }
+}
+
+// [[particle]]: one point mass (lesson 01).
+void read_particle(SceneTable& t, Scene& scene) {
+  const Vec3 x = t.required_vec3("position", "m");
+  const Vec3 v = t.vec3("velocity", "m/s", Vec3::Zero());
+  const double m = t.required_number("mass", Range::positive("kg"));
+  check_particle_mass(t, "mass", m, fmt::format("'mass' in {}", t.display_name()));
+  const bool pinned = t.boolean("pinned", false);
+  if (pinned && v != Vec3::Zero()) {
+    // pin() sets v = 0: a velocity given here would be dropped without a word.
+    t.fail("velocity", fmt::format("{} is pinned but has velocity ({}, {}, {}) m/s; expected no "
+                                   "velocity (a pinned particle never moves)",
+                                   t.display_name(), v.x(), v.y(), v.z()));
+  }
+  const double max_speed = scene.world.guard.max_speed;
+  if (!(v.array().abs() <= max_speed).all()) {
+    t.fail("velocity", fmt::format("{} starts at velocity ({}, {}, {}) m/s, beyond the guard's "
+                                   "max_speed = {} m/s; expected each component within {} m/s (a "
+                                   "larger max_speed in [guard] allows more)",
+                                   t.display_name(), v.x(), v.y(), v.z(), max_speed, max_speed));
+  }
+  const Index i = scene.world.particles.add(x, v, m);
+  check_within_guard(t, "position", scene, i, t.display_name());
+  if (pinned) pin(scene.world.particles, i);
+}
+
+// Pins of a builder: a name (e.g. "top-corners") or an array of local indices below `count`.
+std::vector<Index> read_pins(
+    SceneTable& t, Index count,
+    const std::function<bool(std::string_view, std::vector<Index>&)>& named,
+    std::string_view names) {
+  std::vector<Index> pins;
+  if (t.has("pins") && !t.is_string("pins") && !t.is_array("pins")) {
+    t.fail("pins", fmt::format("'pins' in {} is {}; expected a pin set ({}) or an array of "
+                               "particle indices",
+                               t.display_name(), t.type_name("pins"), names));
+  }
+  if (t.is_string("pins")) {
+    const std::string name = *t.string("pins");
+    if (!named(name, pins)) {
+      t.fail("pins", fmt::format("unknown pin set '{}' in {}; expected one of: {}, or an array "
+                                 "of particle indices",
+                                 name, t.display_name(), names));
+    }
+  } else {
+    for (long i : t.integer_list("pins", 0, static_cast<long>(count) - 1, "pin index")) {
+      pins.push_back(i);
+    }
+  }
+  return pins;
+}
+
+// Total mass from `mass` [kg] or from `density` [kg/m^2] times `area` [m^2]: exactly one of the
+// two keys. The total is shared by `count` particles, each of which must keep a mass.
+double read_mass_or_density(SceneTable& t, double area, Index count) {
+  if (t.has("mass") && t.has("density")) {
+    t.fail("density", fmt::format("{} gives both mass and density; expected one of the two",
+                                  t.display_name()));
+  }
+  double mass = 0.0;
+  if (t.has("density")) {
+    const double rho = t.number("density", Range::positive("kg/m^2"), 0.0);
+    mass = rho * area;
+    if (!std::isfinite(mass)) {
+      t.fail("density",
+             fmt::format("density = {} kg/m^2 over an area of {:.3g} m^2 is a mass of {} "
+                         "kg; expected a finite mass",
+                         rho, area, mass));
+    }
+  } else {
+    mass = t.required_number("mass", Range::positive("kg"));
+  }
+  check_particle_mass(t, t.has("density") ? "density" : "mass", mass / static_cast<double>(count),
+                      fmt::format("the cloth's mass of {} kg shared by {} particles", mass, count));
+  return mass;
+}
+
+// [rope]: a chain of particles from start to end (lesson 02).
+void read_rope(SceneTable& t, Scene& scene) {
+  RopeSpec spec;
+  spec.start = t.required_vec3("start", "m");
+  spec.end = t.required_vec3("end", "m");
+  spec.particles = t.required_integer("particles", 2, 1000000);
+  spec.mass = t.required_number("mass", Range::positive("kg"));
+  check_particle_mass(
+      t, "mass", spec.mass / static_cast<double>(spec.particles),
+      fmt::format("the rope's mass of {} kg shared by {} particles", spec.mass, spec.particles));
+  if (spec.start == spec.end) {
+    t.fail("end", "the rope's start and end are the same point; expected a rope of some length");
+  }
+  Particles& p = scene.world.particles;
+  const Rope rope = add_rope(p, spec);
+  // The rope lies between its two ends.
+  check_within_guard(t, "start", scene, rope.first, "the rope's first particle");
+  check_within_guard(t, "end", scene, rope.first + rope.count - 1, "the rope's last particle");
+  const auto named = [&](std::string_view name, std::vector<Index>& out) {
+    if (name == "first" || name == "both") out.push_back(0);
+    if (name == "last" || name == "both") out.push_back(rope.count - 1);
+    return name == "first" || name == "last" || name == "both" || name == "none";
+  };
+  for (Index i : read_pins(t, rope.count, named, "first, last, both, none"))
+    pin(p, rope.first + i);
+  scene.rope = rope;
+}
+
+// The most particles a [cloth] may have, as many as a [rope] (a 1000 x 1000 grid): the 4096 x 4096
+// that rows and cols alone allow would need gigabytes before its first step.
+constexpr Index kMaxClothParticles = 1000000;
+
+// [cloth]: a rectangular grid of particles (lesson 02).
+void read_cloth(SceneTable& t, Scene& scene) {
+  ClothSpec spec;
+  spec.rows = t.required_integer("rows", 2, 4096);
+  spec.cols = t.required_integer("cols", 2, 4096);
+  if (spec.rows * spec.cols > kMaxClothParticles) {
+    t.fail("cols", fmt::format("[cloth] of {} x {} is {} particles; expected at most {} (rows x "
+                               "cols)",
+                               spec.rows, spec.cols, spec.rows * spec.cols, kMaxClothParticles));
+  }
+  spec.spacing = t.required_number("spacing", Range::positive("m"));
+  spec.origin = t.vec3("origin", "m", Vec3::Zero());
+  spec.horizontal = t.choice("plane", {"vertical", "horizontal"}, "vertical") == "horizontal";
+  const double area = static_cast<double>(spec.rows - 1) * static_cast<double>(spec.cols - 1) *
+                      spec.spacing * spec.spacing;
+  spec.mass = read_mass_or_density(t, area, spec.rows * spec.cols);
+  Particles& p = scene.world.particles;
+  const ClothGrid grid = add_cloth(p, spec);
+  // The grid lies between its first particle, at the origin, and its last.
+  check_within_guard(t, "origin", scene, grid.first, "the cloth's first particle");
+  check_within_guard(t, "spacing", scene, grid.first + grid.size() - 1,
+                     "the cloth's last particle");
+  const auto named = [&](std::string_view name, std::vector<Index>& out) {
+    return named_pins(grid, name, out);
+  };
+  for (Index i :
+       read_pins(t, grid.size(), named, "top-corners, corners, top-edge, left-edge, none")) {
+    pin(p, grid.first + i);
+  }
+  scene.cloth = grid;
+  scene.world.triangles = grid_triangles(grid);
+}
+
+// [solid]: a box-shaped lattice of particles, a soft solid (lesson 09).
+void read_solid(SceneTable& t, Scene& scene) {
+  SolidSpec spec;
+  if (!t.has("particles")) {
+    t.fail("particles",
+           "[solid] has no 'particles'; expected particles = [nx, ny, nz], whole "
+           "numbers from 2 to 1000 (particles along x, y and z)");
+  }
+  const std::vector<long> n = t.integer_list("particles", 2, 1000, "particle count");
+  if (n.size() != 3) {
+    t.fail("particles", fmt::format("'particles' in [solid] has {} elements; expected [nx, ny, "
+                                    "nz], three whole numbers from 2 to 1000",
+                                    n.size()));
+  }
+  spec.nx = n[0], spec.ny = n[1], spec.nz = n[2];
+  if (spec.nx * spec.ny * spec.nz > kMaxClothParticles) {
+    t.fail("particles",
+           fmt::format("[solid] of {} x {} x {} is {} particles; expected at most {} "
+                       "(nx ny nz)",
+                       spec.nx, spec.ny, spec.nz, spec.nx * spec.ny * spec.nz, kMaxClothParticles));
+  }
+  spec.size = t.required_vec3("size", "m");
+  if (!(spec.size.array() > 0.0).all()) {
+    t.fail("size", fmt::format("'size' in [solid] is ({}, {}, {}) m; expected three edge lengths "
+                               "> 0 [m]",
+                               spec.size.x(), spec.size.y(), spec.size.z()));
+  }
+  spec.corner = t.vec3("corner", "m", Vec3::Zero());
+  spec.mass = t.required_number("mass", Range::positive("kg"));
+  const Index count = spec.nx * spec.ny * spec.nz;
+  check_particle_mass(
+      t, "mass", spec.mass / static_cast<double>(count),
+      fmt::format("the solid's mass of {} kg shared by {} particles", spec.mass, count));
+  Particles& p = scene.world.particles;
+  const SolidLattice lattice = add_solid(p, spec);
+  // The box lies between its lowest corner and the opposite one.
+  check_within_guard(t, "corner", scene, lattice.first, "the solid's first particle");
+  check_within_guard(t, "size", scene, lattice.first + lattice.size() - 1,
+                     "the solid's last particle");
+  const auto named = [&](std::string_view name, std::vector<Index>& out) {
+    return named_solid_pins(lattice, name, out);
+  };
+  for (Index i : read_pins(t, lattice.size(), named, "top-face, bottom-face, none"))
+    pin(p, lattice.first + i);
+  scene.solid = lattice;
+  // Its outside, for the viewer and mesh files, after any cloth's triangles.
+  const std::vector<Triangle> surface = solid_surface_triangles(lattice);
+  scene.world.triangles.insert(scene.world.triangles.end(), surface.begin(), surface.end());
+}
+
+// [[spring]]: one spring-damper between two particles given by index (lesson 02).
+void read_spring(SceneTable& t, Scene& scene) {
+  const Particles& p = scene.world.particles;
+  if (p.size() < 2)
+    t.fail("i", "a [[spring]] needs two particles; expected [[particle]] tables first");
+  const long last = static_cast<long>(p.size()) - 1;
+  const Index i = t.required_integer("i", 0, last);
+  const Index j = t.required_integer("j", 0, last);
+  if (i == j)
+    t.fail("j", fmt::format("the spring joins particle {} to itself; expected i != j", i));
+  const double ks = t.required_number("ks", Range::non_negative("N/m"));
+  const double kd = t.number("kd", Range::non_negative("N s/m"), 0.0);
+  const double l0 = t.number("l0", Range::non_negative("m"), -1.0);  // default: distance now
+  scene.springs.add(i, j, ks, kd, l0, p.x);
+}
+
+// [springs]: structural and shear springs of the cloth, the rope's springs (lesson 02), the
+// solid's edges and diagonals (lesson 09).
+void read_springs(SceneTable& t, Scene& scene) {
+  if (!scene.cloth && !scene.rope && !scene.solid) {
+    t.fail("ks",
+           "[springs] has nothing to connect; expected a [cloth], a [rope] or a [solid] (springs "
+           "between single particles are [[spring]] tables)");
+  }
+  const double ks = t.required_number("ks", Range::non_negative("N/m"));
+  const double kd = t.number("kd", Range::non_negative("N s/m"), 0.0);
+  const double shear_ks = t.number("shear_ks", Range::non_negative("N/m"), ks);
+  const double shear_kd = t.number("shear_kd", Range::non_negative("N s/m"), kd);
+  const Matrix3X& x = scene.world.particles.x;
+  if (scene.rope)
+    add_spring_family(scene.springs, rope_pairs(scene.rope->count), scene.rope->first, ks, kd, x);
+  if (scene.cloth) {
+    const ClothGrid& g = *scene.cloth;
+    add_spring_family(scene.springs, structural_pairs(g.rows, g.cols), g.first, ks, kd, x);
+    add_spring_family(scene.springs, shear_pairs(g.rows, g.cols), g.first, shear_ks, shear_kd, x);
+  }
+  if (scene.solid) {
+    // The cell's edges take ks and kd; both kinds of diagonal resist shear, and take the shear
+    // constants, as the cloth's diagonals do.
+    const SolidLattice& g = *scene.solid;
+    add_spring_family(scene.springs, solid_structural_pairs(g.nx, g.ny, g.nz), g.first, ks, kd, x);
+    add_spring_family(scene.springs, solid_face_diagonal_pairs(g.nx, g.ny, g.nz), g.first, shear_ks,
+                      shear_kd, x);
+    add_spring_family(scene.springs, solid_body_diagonal_pairs(g.nx, g.ny, g.nz), g.first, shear_ks,
+                      shear_kd, x);
+  }
+}
+
+// [bending]: flexion springs two apart, with their own constants (lesson 04).
+void read_bending(SceneTable& t, Scene& scene) {
+  if (!scene.cloth && !scene.rope) {
+    t.fail("ks", "[bending] has nothing to bend; expected a [cloth] or a [rope]");
+  }
+  const double ks = t.required_number("ks", Range::non_negative("N/m"));
+  const double kd = t.number("kd", Range::non_negative("N s/m"), 0.0);
+  const Matrix3X& x = scene.world.particles.x;
+  // The cloth's bending layer (exercise 4.1 picks its pairs), then the rope's, if any.
+  SpringSet bending = scene.cloth ? bending_springs(*scene.cloth, ks, kd, x) : SpringSet{};
+  if (scene.rope) {
+    add_spring_family(bending, rope_bending_pairs(scene.rope->count), scene.rope->first, ks, kd, x);
+  }
+  scene.world.force_effects.push_back(
+      std::make_unique<SpringDampers>("bending", std::move(bending)));
+}
+
+// [damping]: a damper from every particle to the world, f = -rate m v (lesson 02).
+void read_damping(SceneTable& t, Scene& scene) {
+  const double rate = t.required_number("rate", Range::non_negative("1/s"));
+  scene.world.force_effects.push_back(std::make_unique<Damping>(rate));
+}
+
+// [aerodynamics]: air on the cloth's triangles (lesson 03).
+void read_aerodynamics(SceneTable& t, Scene& scene) {
+  if (!scene.cloth) {
+    t.fail("rho", "[aerodynamics] acts on a cloth's triangles; expected a [cloth] table");
+  }
+  const double rho = t.number("rho", Range::non_negative("kg/m^3"), kAirDensity);
+  const double cd = t.number("cd", Range::non_negative(""), 1.0);
+  const Vec3 wind = t.vec3("wind", "m/s", Vec3::Zero());
+  scene.world.force_effects.push_back(
+      std::make_unique<Aerodynamics>(scene.world.triangles, rho, cd, wind));
+}
+
+// [drag]: fluid drag on every particle (lesson 03).
+void read_drag(SceneTable& t, Scene& scene) {
+  const double rho = t.number("rho", Range::non_negative("kg/m^3"), kAirDensity);
+  const double cd = t.number("cd", Range::non_negative(""), 0.47);  // a sphere's
+  const double area = t.required_number("area", Range::positive("m^2"));
+  const Vec3 wind = t.vec3("wind", "m/s", Vec3::Zero());
+  scene.world.force_effects.push_back(std::make_unique<FluidDrag>(rho, cd, area, wind));
+}
+
+// [buoyancy]: a fluid below y = surface lifts the particles in it (lesson 03).
+void read_buoyancy(SceneTable& t, Scene& scene) {
+  const double rho = t.number("rho", Range::positive("kg/m^3"), 1000.0);  // water
+  const double volume = t.required_number("volume", Range::positive("m^3"));
+  const double surface = t.number("surface", Range::any("m"), 0.0);
+  const double g = t.number("g", Range::positive("m/s^2"), 9.8);
+  scene.world.force_effects.push_back(std::make_unique<Buoyancy>(rho, volume, surface, g));
+}
+
+// [gravity]: uniform gravity, f = m g (lesson 01).
+void read_gravity(SceneTable& t, Scene& scene) {
+  const Vec3 g = t.vec3("g", "m/s^2", Vec3(0.0, -9.8, 0.0));
+  scene.world.force_effects.push_back(std::make_unique<UniformGravity>(g));
+}
+
+// [gravitation]: Newton's gravitation between every pair of particles (lesson 01).
+void read_gravitation(SceneTable& t, Scene& scene) {
+  const double G = t.number("G", Range::positive("N m^2/kg^2"), kGravitationalConstant);
+  scene.world.force_effects.push_back(std::make_unique<Gravitation>(G));
+}
+
+// The contact constants shared by [ground] and [sphere] (lesson 05).
+ContactMaterial read_material(SceneTable& t) {
+  ContactMaterial m;
+  m.e = t.number("e", Range{0.0, 1.0, false, ""}, m.e);
+  m.mu_s = t.number("mu_s", Range::non_negative(""), m.mu_s);
+  m.mu_d = t.number("mu_d", Range::non_negative(""), std::min(m.mu_d, m.mu_s));
+  m.rest_speed = t.number("rest_speed", Range::non_negative("m/s"), m.rest_speed);
+  if (m.mu_d > m.mu_s) {
+    t.fail("mu_d", fmt::format("mu_d = {} is larger than mu_s = {}; expected mu_d <= mu_s (sliding "
+                               "never grips harder than sticking)",
+                               m.mu_d, m.mu_s));
+  }
+  return m;
+}
+
+// The "springs" effect: structural, shear and one-by-one springs make one effect, built once all
+// are known (their tables come before any that needs the effect) and first in the list, so that
+// reports read in the lessons' order: springs, bending, gravity, ... The post-step effects that
+// change these springs are given it when they are made.
+bool has_springs(const Scene& scene) {
+  const auto& effects = scene.world.force_effects;
+  return scene.springs.size() > 0 || (!effects.empty() && effects.front()->name() == "springs");
+}
+
+SpringDampers& springs_effect(Scene& scene) {
+  auto& effects = scene.world.force_effects;
+  if (effects.empty() || effects.front()->name() != "springs") {
+    effects.insert(effects.begin(),
+                   std::make_unique<SpringDampers>("springs", std::move(scene.springs)));
+    scene.springs = SpringSet{};
+  }
+  return static_cast<SpringDampers&>(*effects.front());
+}
+
+// [strain_limit]: springs shortened back to a largest strain after each step (lesson 09).
+void read_strain_limit(SceneTable& t, Scene& scene) {
+  if (!has_springs(scene)) {
+    t.fail("max_strain",
+           "[strain_limit] has no springs to limit; expected [springs] or [[spring]] tables");
+  }
+  StrainLimits limits;
+  limits.max_strain = t.required_number("max_strain", Range::non_negative(""));
+  limits.max_compression =
+      t.number("max_compression", Range{0.0, 1.0, false, ""}, limits.max_compression);
+  const long iterations = t.integer("iterations", 1, 10000, 10);
+  scene.world.post_step_effects.push_back(std::make_unique<StrainLimiting>(
+      springs_effect(scene), limits, static_cast<int>(iterations)));
+}
+
+// The most cells of edge `thickness` along each axis of the guard's box, |x| <= max_position:
+// cell coordinates up to 1e15 fit easily in 64-bit integers (about 9.2e18).
+constexpr double kMaxCellsAcross = 1e15;
+
+// [self_collision]: particles kept `thickness` apart from each other (lesson 10).
+void read_self_collision(SceneTable& t, Scene& scene) {
+  SelfContact c;
+  c.thickness = t.required_number("thickness", Range::positive("m"));
+  const double bound = scene.world.guard.max_position;
+  if (bound / c.thickness > kMaxCellsAcross) {
+    t.fail("thickness",
+           fmt::format("thickness = {} m makes {:.3g} cells across the guard's max_position = {} "
+                       "m; expected thickness >= {:.3g} m (or a smaller max_position in [guard])",
+                       c.thickness, bound / c.thickness, bound, bound / kMaxCellsAcross));
+  }
+  c.e = t.number("e", Range{0.0, 1.0, false, ""}, c.e);
+  c.mu_s = t.number("mu_s", Range::non_negative(""), c.mu_s);
+  c.mu_d = t.number("mu_d", Range::non_negative(""), std::min(c.mu_d, c.mu_s));
+  if (c.mu_d > c.mu_s) {
+    t.fail("mu_d", fmt::format("mu_d = {} is larger than mu_s = {}; expected mu_d <= mu_s (sliding "
+                               "never grips harder than sticking)",
+                               c.mu_d, c.mu_s));
+  }
+  const long iterations = t.integer("iterations", 1, 1000, 4);
+  scene.world.post_step_effects.push_back(
+      std::make_unique<SelfCollision>(c, static_cast<int>(iterations), scene.world.particles.x));
+}
+
+// [ground]: the plane y = y0, solid below (lesson 05).
+void read_ground(SceneTable& t, Scene& scene) {
+  const double y0 = t.number("y", Range::any("m"), 0.0);
+  const bool simple = t.choice("model", {"coulomb", "simple"}, "coulomb") == "simple";
+  const double friction = t.number("friction", Range{0.0, 1.0, false, ""}, 0.0);
+  if (!simple && t.has("friction")) {
+    t.fail("friction",
+           "'friction' belongs to model = \"simple\"; expected mu_s and mu_d for the "
+           "Coulomb model");
+  }
+  if (simple) {
+    for (std::string_view key : {"mu_s", "mu_d", "rest_speed"}) {
+      if (t.has(key)) {
+        t.fail(key, fmt::format("'{}' belongs to the Coulomb model; expected only e and friction "
+                                "with model = \"simple\"",
+                                key));
+      }
+    }
+  }
+  const ContactMaterial m = read_material(t);
+  scene.world.post_step_effects.push_back(std::make_unique<Ground>(
+      y0, m, simple ? Ground::Model::simple : Ground::Model::coulomb, friction));
+}
+
+// [sphere]: a solid ball (lesson 05).
+void read_sphere(SceneTable& t, Scene& scene) {
+  const Vec3 centre = t.required_vec3("centre", "m");
+  const double radius = t.required_number("radius", Range::positive("m"));
+  scene.world.post_step_effects.push_back(
+      std::make_unique<Sphere>(centre, radius, read_material(t)));
+}
+
+// [plasticity]: springs whose rest length yields past an elastic limit (lesson 06).
+void read_plasticity(SceneTable& t, Scene& scene) {
+  if (!has_springs(scene)) {
+    t.fail("yield_strain",
+           "[plasticity] has no springs to deform; expected [springs] or "
+           "[[spring]] tables");
+  }
+  PlasticLimits limits;
+  limits.yield_strain = t.required_number("yield_strain", Range{0.0, 0.99, true, ""});
+  limits.flow_rate = t.number("flow_rate", Range::positive("1/s"), limits.flow_rate);
+  limits.max_strain = t.number("max_strain", Range{0.0, 0.99, false, ""}, limits.max_strain);
+  scene.world.post_step_effects.push_back(
+      std::make_unique<Plasticity>(springs_effect(scene), limits));
+}
+
+// [tearing]: springs that break past a tearing limit, and the triangles they edge (lesson 06).
+void read_tearing(SceneTable& t, Scene& scene) {
+  if (!has_springs(scene)) {
+    t.fail("strain", "[tearing] has no springs to tear; expected [springs] or [[spring]] tables");
+  }
+  const double strain = t.required_number("strain", Range::positive(""));
+  const long max_tears = t.integer("max_per_step", 0, 1000000000, 0);
+  // The effects it changes, by type, once: bending springs and the air's triangles, if any.
+  SpringDampers* bending = nullptr;
+  std::vector<Aerodynamics*> aerodynamics;
+  for (auto& effect : scene.world.force_effects) {
+    if (effect->name() == "bending") bending = dynamic_cast<SpringDampers*>(effect.get());
+    if (auto* aero = dynamic_cast<Aerodynamics*>(effect.get())) aerodynamics.push_back(aero);
+  }
+  scene.world.post_step_effects.push_back(
+      std::make_unique<Tearing>(springs_effect(scene), bending, std::move(aerodynamics), strain,
+                                static_cast<size_t>(max_tears)));
+}
+
+// [integrator]: the method, the time step and how long to simulate.
+void read_integrator(SceneTable& t, Scene& scene) {
+  const std::vector<std::string_view> names(integrator_names().begin(), integrator_names().end());
+  const std::string method = t.choice("method", names, "symplectic-euler");
+  scene.world.integrator = make_integrator(method);
+  // The linear solver of the implicit method; another method has none to tune.
+  for (const char* key : {"tolerance", "max_iterations"}) {
+    if (method != "implicit-euler" && t.has(key)) {
+      t.fail(key, fmt::format("{} tunes the linear solver of method = \"implicit-euler\", but "
+                              "method is \"{}\"; expected no {} here",
+                              key, method, key));
+    }
+  }
+  if (auto* implicit = dynamic_cast<ImplicitEuler*>(scene.world.integrator.get())) {
+    implicit->tolerance = t.number("tolerance", Range{0.0, 1.0, true, ""}, implicit->tolerance);
+    implicit->max_iterations =
+        static_cast<int>(t.integer("max_iterations", 1, 1'000'000, implicit->max_iterations));
+  }
+  scene.dt = t.required_number("dt", Range::positive("s"));
+  scene.duration = t.required_number("duration", Range::positive("s"));
+  if (scene.dt > scene.duration) {
+    t.fail("dt", fmt::format("dt = {} s is longer than duration = {} s; expected dt <= duration",
+                             scene.dt, scene.duration));
+  }
+  // Scene::step_count() rounds duration / dt to a whole number, which must fit in a long.
+  if (scene.duration / scene.dt > 1e9) {
+    t.fail("dt", fmt::format("dt = {} s over duration = {} s is {:.3g} steps; expected at most "
+                             "1e9 steps (a larger dt or a shorter duration)",
+                             scene.dt, scene.duration, scene.duration / scene.dt));
+  }
+}
+
+// [output]: what a run writes.
+void read_output(SceneTable& t, Scene& scene) {
+  scene.output.fps = t.number("fps", Range::positive("frames/s"), scene.output.fps);
+}
+
+// [guard]: the bounds beyond which a run is stopped as blown up.
+void read_guard(SceneTable& t, Scene& scene) {
+  Guard& guard = scene.world.guard;
+  guard.max_position = t.number("max_position", Range::positive("m"), guard.max_position);
+  guard.max_speed = t.number("max_speed", Range::positive("m/s"), guard.max_speed);
+  guard.max_energy_growth =
+      t.number("max_energy_growth", Range::positive(""), guard.max_energy_growth);
+}
+
+// [engine]: how the engine runs the scene (the physics does not depend on it).
+void read_engine(SceneTable& t, Scene& scene) {
+  World& world = scene.world;
+  world.threads = static_cast<int>(t.integer("threads", 1, 1024, world.threads));
+  if (!t.boolean("fast_path", true)) world.backend.reset();
+}
+
+// The order here is the order of reading: the guard's bounds, which the particles must start
+// within, then whatever creates particles, then the effects on them.
+constexpr std::array kKinds = {
+    SceneTableKind{"guard", false, false, "max_position max_speed max_energy_growth",
+                   "[guard] with max_position and max_speed", read_guard},
+    SceneTableKind{"particle", true, false, "position velocity mass pinned",
+                   "[[particle]] with position, velocity and mass", read_particle},
+    SceneTableKind{"rope", false, false, "start end particles mass pins",
+                   "[rope] with start, end, particles and mass", read_rope},
+    SceneTableKind{"cloth", false, false, "rows cols spacing origin plane mass density pins",
+                   "[cloth] with rows, cols, spacing and mass", read_cloth},
+    SceneTableKind{"solid", false, false, "particles size corner mass pins",
+                   "[solid] with particles, size and mass", read_solid},
+    SceneTableKind{"spring", true, false, "i j ks kd l0", "[[spring]] with i, j and ks",
+                   read_spring},
+    SceneTableKind{"springs", false, false, "ks kd shear_ks shear_kd", "[springs] with ks",
+                   read_springs},
+    SceneTableKind{"bending", false, false, "ks kd", "[bending] with ks", read_bending},
+    SceneTableKind{"damping", false, false, "rate", "[damping] with rate", read_damping},
+    SceneTableKind{"gravity", false, false, "g", "[gravity] with g", read_gravity},
+    SceneTableKind{"gravitation", false, false, "G", "[gravitation] with G", read_gravitation},
+    SceneTableKind{"aerodynamics", false, false, "rho cd wind",
+                   "[aerodynamics] with rho, cd and wind", read_aerodynamics},
+    SceneTableKind{"drag", false, false, "rho cd area wind", "[drag] with area", read_drag},
+    SceneTableKind{"buoyancy", false, false, "rho volume surface g", "[buoyancy] with volume",
+                   read_buoyancy},
+    // Before the colliders, so that a contact has the last word on where a particle ends up.
+    SceneTableKind{"strain_limit", false, false, "max_strain max_compression iterations",
+                   "[strain_limit] with max_strain", read_strain_limit},
+    SceneTableKind{"self_collision", false, false, "thickness e mu_s mu_d iterations",
+                   "[self_collision] with thickness", read_self_collision},
+    SceneTableKind{"ground", false, false, "y e mu_s mu_d rest_speed model friction",
+                   "[ground] with y, e, mu_s and mu_d", read_ground},
+    SceneTableKind{"sphere", false, false, "centre radius e mu_s mu_d rest_speed",
+                   "[sphere] with centre and radius", read_sphere},
+    SceneTableKind{"plasticity", false, false, "yield_strain flow_rate max_strain",
+                   "[plasticity] with yield_strain", read_plasticity},
+    SceneTableKind{"tearing", false, false, "strain max_per_step", "[tearing] with strain",
+                   read_tearing},
+    SceneTableKind{"integrator", false, true, "method dt duration tolerance max_iterations",
+                   "[integrator] with method, dt [s] and duration [s]", read_integrator},
+    SceneTableKind{"output", false, false, "fps", "[output] with fps", read_output},
+    SceneTableKind{"engine", false, false, "threads fast_path", "[engine] with threads",
+                   read_engine},
+};
+
+}  // namespace
+
+std::span<const SceneTableKind> scene_table_kinds() {
+  return kKinds;
+}
+
+const SceneTableKind* find_scene_table(std::string_view name) {
+  for (const SceneTableKind& kind : kKinds) {
+    if (kind.name == name) return &kind;
+  }
+  return nullptr;
+}
+
+std::string scene_table_names() {
+  std::string names = "title";
+  for (const SceneTableKind& kind : kKinds) {
+    names += ' ';
+    names += kind.name;
+  }
+  return names;
+}
+
+void finish_scene(Scene& scene, const std::function<void(const std::string&)>& fail) {
+  if (scene.world.particles.size() == 0) {
+    fail(
+        "the scene has no particles; expected [[particle]] tables, a [rope], a [cloth] or a "
+        "[solid]");
+  }
+  if (scene.springs.size() > 0) springs_effect(scene);
+}
+
+}  // namespace clothlab

@@ -1,0 +1,65 @@
+// lesson.hpp: what every lesson program shares, so that each main.cpp holds only its lesson.
+#pragma once
+
+#include <chrono>
+#include <exception>
+#include <filesystem>
+#include <source_location>
+#include <stdexcept>
+#include <type_traits>
+
+#include <fmt/format.h>
+
+#include "app/exit_codes.hpp"
+#include "clothlab/core/not_implemented.hpp"
+#include "clothlab/core/world.hpp"
+#include "clothlab/forces/spring_damper.hpp"
+
+namespace clothlab::lesson {
+
+// The file `name` in the lesson's own folder (its scenes lie next to its main.cpp).
+inline std::filesystem::path lesson_file(
+    const char* name, std::source_location here = std::source_location::current()) {
+  return std::filesystem::path(here.file_name()).parent_path() / name;
+}
+
+// The springs of the world's "springs" effect (structural, shear, [[spring]]).
+inline SpringSet& springs_of(World& world) {
+  SpringDampers* springs = find_spring_effect(world, "springs");
+  if (!springs) throw std::runtime_error("the scene has no [springs]");
+  return springs->springs();
+}
+
+// Kinetic plus potential energy [J].
+inline double energy(const World& world) {
+  return world.kinetic_energy() + world.potential_energy();
+}
+
+using Clock = std::chrono::steady_clock;
+
+// Wall time since `start` [s].
+inline double seconds_since(Clock::time_point start) {
+  return std::chrono::duration<double>(Clock::now() - start).count();
+}
+
+// Runs the lesson's tables and says what stopped them: an exercise still a stub (exit code 4,
+// as `clothlab run` gives), or any other error (1). A body may return an exit code of its own.
+template <class Body>
+int run(const char* program, Body body) {
+  try {
+    if constexpr (std::is_void_v<decltype(body())>) {
+      body();
+    } else {
+      return body();
+    }
+  } catch (const NotImplemented& error) {
+    fmt::print(stderr, "{}: {}\n", program, error.what());
+    return app::kExitNotDone;
+  } catch (const std::exception& error) {
+    fmt::print(stderr, "{}: {}\n", program, error.what());
+    return app::kExitFailed;
+  }
+  return app::kExitOk;
+}
+
+}  // namespace clothlab::lesson
