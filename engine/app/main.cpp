@@ -25,6 +25,7 @@
 #include "analysis/stability.hpp"
 #include "app/bench.hpp"
 #include "app/build_info.hpp"
+#include "app/course.hpp"
 #include "app/demo_scene.hpp"
 #include "app/exit_codes.hpp"
 #include "app/grade.hpp"
@@ -218,6 +219,7 @@ int main(int argc, char** argv) {
   app::add_grade_command(app);
   app::add_watch_command(app);
   app::add_bench_command(app);
+  app::add_course_command(app);
 
   try {
     app.parse(argc, argv);

@@ -27,7 +27,7 @@ endif()
 file(MAKE_DIRECTORY ${tree})
 
 # What a student gets: the files the project tracks under these names, never build folders.
-foreach(file CMakeLists.txt CMakePresets.json README.md .clang-format .gitignore)
+foreach(file CMakeLists.txt CMakePresets.json README.md course.toml .clang-format .gitignore)
   if(EXISTS ${SOURCE}/${file})
     file(COPY ${SOURCE}/${file} DESTINATION ${tree})
   endif()
