@@ -12,14 +12,16 @@
 #include <fmt/color.h>
 #include <fmt/core.h>
 
-#include "io/json.hpp"
+#include <nlohmann/json.hpp>
 
 #include <algorithm>
 #include <cctype>
 #include <cerrno>
+#include <cmath>
 #include <cstring>
 #include <filesystem>
 #include <system_error>
+#include <utility>
 
 namespace clothlab::app::grading {
 
@@ -31,9 +33,12 @@ std::string paint(bool colour, fmt::text_style style, const std::string& text) {
   return colour ? fmt::format(style, "{}", text) : text;
 }
 
-// JSON text of a report: invalid UTF-8 from a test's output replaced first.
-std::string json_text(const std::string& text) {
-  return clothlab::json_string(valid_utf8(text));
+using Json = nlohmann::ordered_json;  // keeps the keys in the order they are set
+
+// A report's JSON text. Its strings were made valid UTF-8 (valid_utf8) when they were set; the
+// error handler replaces anything invalid that is left instead of throwing, all the same.
+std::string json_dump(const Json& json, int indent) {
+  return json.dump(indent, ' ', false, Json::error_handler_t::replace);
 }
 
 std::string xml_escape(const std::string& text) {
@@ -214,21 +219,26 @@ void write_file(const std::string& path, const std::string& text) {
 
 std::string gradescope_json(const std::vector<Case>& cases, double seconds,
                             const std::string& output) {
+  Json json;
+  json["score"] = 0;  // set below, and first in the file
+  json["execution_time"] = std::round(seconds * 1000) / 1000;
+  json["output"] = valid_utf8(output);
+  json["tests"] = Json::array();
   int score = 0;
-  std::string tests;
   for (const Case& c : cases) {
     score += c.passed ? c.points : 0;
-    tests += fmt::format(
-        "{}\n    {{\"name\": {}, \"number\": {}, \"score\": {}, \"max_score\": {}, "
-        "\"status\": \"{}\", \"output\": {}, \"visibility\": \"{}\"}}",
-        tests.empty() ? "" : ",", json_text(c.name), json_text(number_of(c.exercise)),
-        c.passed ? c.points : 0, c.points, c.passed ? "passed" : "failed",
-        json_text(case_report(c, true)), c.visibility);
+    Json test;
+    test["name"] = valid_utf8(c.name);
+    test["number"] = valid_utf8(number_of(c.exercise));
+    test["score"] = c.passed ? c.points : 0;
+    test["max_score"] = c.points;
+    test["status"] = c.passed ? "passed" : "failed";
+    test["output"] = valid_utf8(case_report(c, true));
+    test["visibility"] = c.visibility;
+    json["tests"].push_back(std::move(test));
   }
-  return fmt::format(
-      "{{\n  \"score\": {},\n  \"execution_time\": {:.3f},\n  \"output\": {},\n  \"tests\": [{}\n  "
-      "]\n}}\n",
-      score, seconds, json_text(output), tests);
+  json["score"] = score;
+  return json_dump(json, 2) + "\n";
 }
 
 std::string junit_xml(const std::vector<Case>& cases, double seconds) {
@@ -273,13 +283,15 @@ std::string junit_xml(const std::vector<Case>& cases, double seconds) {
 // one score per exercise (the problem names an Autolab course defines), the total on the
 // scoreboard.
 std::string autolab_line(const std::vector<Case>& cases) {
-  std::string scores;
+  Json json;
+  json["scores"] = Json::object();
   int total = 0;
   for (const Exercise& x : by_exercise(cases)) {
-    scores += fmt::format("{}{}: {}", scores.empty() ? "" : ", ", json_text(x.id), x.earned);
+    json["scores"][valid_utf8(x.id)] = x.earned;
     total += x.earned;
   }
-  return fmt::format("{{\"scores\": {{{}}}, \"scoreboard\": [{}]}}", scores, total);
+  json["scoreboard"] = Json::array({total});
+  return json_dump(json, -1);  // one line
 }
 
 // A GitHub Classroom autograding workflow with one step per exercise, worth that exercise's
@@ -335,6 +347,7 @@ std::string classroom_workflow(const std::vector<Case>& cases) {
       "      run: sudo apt-get update && sudo apt-get install -y --no-install-recommends g++ "
       "cmake\n"
       "        make libeigen3-dev doctest-dev libfmt-dev libtomlplusplus-dev libcli11-dev\n"
+      "        nlohmann-json3-dev\n"
       "    - name: Build the grader\n"
       "      run: cmake -S . -B build && cmake --build build --parallel 4 --target clothlab\n"
       "        grade-kit\n"
