@@ -5,6 +5,11 @@
 // the exercise kernels under test in a process of their own (grade-kernels-reference, -stubs, or
 // those it builds from the student's exercises or a submission), and reports points per exercise
 // with hints that point to the lesson. It also writes Gradescope results.json and JUnit XML.
+//
+// It lives in app/grade/, a file per job: cases (what a case is and how its verdict is reached),
+// protocol (the grading binary's line protocol), exercises (exercise IDs and lesson hints),
+// reports (every report format), text (text made safe to show) and command (the options and the
+// two subcommands).
 #pragma once
 
 namespace CLI {

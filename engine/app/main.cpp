@@ -3,7 +3,7 @@
 //   clothlab                          run the built-in demo scene
 //   clothlab run SCENE.toml [--out D] simulate a scene and write its frames (--threads N)
 //   clothlab validate SCENE.toml      check a scene without running it
-//   clothlab grade [...]              build and grade the exercises (see grade.cpp)
+//   clothlab grade [...]              build and grade the exercises (see app/grade/)
 //   clothlab watch [exNN[.k]]         grade again on every save of an exercise file
 //   clothlab bench boundary           measure what the exercise boundary costs
 //   clothlab bench speed              the engine's speed on cloths of 32^2 to 256^2 particles

@@ -1,27 +1,12 @@
 #include "io/json.hpp"
 
-#include <fmt/format.h>
-
 namespace clothlab {
 
-std::string json_string(std::string_view text) {
-  std::string out = "\"";
-  for (size_t k = 0; k < text.size(); ++k) {
-    const char ch = text[k];
-    if (ch == '"' || ch == '\\') {
-      out += '\\';
-      out += ch;
-    } else if (ch == '\n') {
-      out += "\\n";
-    } else if (ch == '/' && k > 0 && text[k - 1] == '<') {
-      out += "\\/";
-    } else if (static_cast<unsigned char>(ch) < 0x20) {
-      out += fmt::format("\\u{:04x}", static_cast<int>(ch));
-    } else {
-      out += ch;
-    }
-  }
-  return out + "\"";
+std::string script_safe_json(std::string json) {
+  // "</" occurs only inside strings (JSON has no other '<'), where "\/" is the escape of '/'.
+  for (std::size_t at = json.find("</"); at != std::string::npos; at = json.find("</", at + 3))
+    json.insert(at + 1, 1, '\\');
+  return json;
 }
 
 }  // namespace clothlab

@@ -1,13 +1,12 @@
-// json.hpp: the one JSON helper the engine's writers share (viewer page, grader results).
+// json.hpp: JSON text that may sit inside an HTML <script> element (the viewer page's data).
 #pragma once
 
 #include <string>
-#include <string_view>
 
 namespace clothlab {
 
-// `text` as a JSON string literal, quotes included. Control characters are escaped, and "</" is
-// written "<\/" so that the text can sit inside an HTML <script> element without closing it.
-std::string json_string(std::string_view text);
+// `json` (JSON text) with every "</" written "<\/", which a JSON parser reads as the same text,
+// so that no string in it (a title "</script>", say) can close the <script> element it sits in.
+std::string script_safe_json(std::string json);
 
 }  // namespace clothlab

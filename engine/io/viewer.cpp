@@ -3,8 +3,10 @@
 #include <cstring>
 #include <fstream>
 #include <stdexcept>
+#include <utility>
 
 #include <fmt/format.h>
+#include <nlohmann/json.hpp>
 
 #include "clothlab/after_step/ground_collision.hpp"
 #include "clothlab/forces/spring_damper.hpp"
@@ -36,11 +38,6 @@ std::string base64(const void* data, size_t size) {
   return out;
 }
 
-template <class T>
-std::string json_array(const std::vector<T>& values) {
-  return fmt::format("[{}]", fmt::join(values, ","));
-}
-
 }  // namespace
 
 ViewerRecorder::ViewerRecorder(std::string title, std::string source, long expected_frames,
@@ -62,14 +59,28 @@ void ViewerRecorder::offer(const World& world) {
 }
 
 void ViewerRecorder::write(const World& world, const std::filesystem::path& html) const {
+  using Json = nlohmann::ordered_json;  // keeps the keys in the order they are set
+  Json data;
+  data["title"] = title_;
+  data["source"] = source_;
+  data["particles"] = world.particles.size();
+  data["times"] = times_;
+  data["kinetic"] = kinetic_;
+  data["potential"] = potential_;
+  std::vector<double> total(kinetic_.size());
+  for (size_t k = 0; k < total.size(); ++k)
+    total[k] = kinetic_[k] + potential_[k];
+  data["total"] = total;
   // Each surface as {"from": first frame, "triangles": [i, j, k, ...]}.
-  std::string surfaces;
+  data["surfaces"] = Json::array();
   for (const auto& [from, list] : surfaces_) {
     std::vector<Index> flat;
     for (const Triangle& t : list)
       flat.insert(flat.end(), t.begin(), t.end());
-    if (!surfaces.empty()) surfaces += ",";
-    surfaces += fmt::format("{{\"from\":{},\"triangles\":{}}}", from, json_array(flat));
+    Json surface;
+    surface["from"] = from;
+    surface["triangles"] = flat;
+    data["surfaces"].push_back(std::move(surface));
   }
   std::vector<Index> springs;
   for (const auto& effect : world.force_effects) {
@@ -80,44 +91,35 @@ void ViewerRecorder::write(const World& world, const std::filesystem::path& html
       }
     }
   }
-  // Colliders, drawn so that a student sees what the cloth lies on.
-  std::string colliders;
-  for (const auto& effect : world.post_step_effects) {
-    if (!colliders.empty()) colliders += ",";
-    if (const auto* g = dynamic_cast<const Ground*>(effect.get())) {
-      colliders += fmt::format("{{\"type\":\"ground\",\"y\":{}}}", g->y0());
-    } else if (const auto* b = dynamic_cast<const Sphere*>(effect.get())) {
-      colliders += fmt::format("{{\"type\":\"sphere\",\"centre\":[{},{},{}],\"radius\":{}}}",
-                               b->centre().x(), b->centre().y(), b->centre().z(), b->radius());
-    } else if (!colliders.empty()) {
-      colliders.pop_back();
-    }
-  }
+  data["springs"] = springs;
   std::vector<Index> pins;
   for (Index i = 0; i < world.particles.size(); ++i) {
     if (world.particles.inv_m[i] == 0.0) pins.push_back(i);
   }
-  std::vector<double> total(kinetic_.size());
-  for (size_t k = 0; k < total.size(); ++k)
-    total[k] = kinetic_[k] + potential_[k];
-
-  std::string frames = "[";
-  for (const std::vector<float>& frame : positions_) {
-    if (frames.size() > 1) frames += ",";
-    frames += '"';
-    frames += base64(frame.data(), frame.size() * sizeof(float));
-    frames += '"';
+  data["pins"] = pins;
+  // Colliders, drawn so that a student sees what the cloth lies on.
+  data["colliders"] = Json::array();
+  for (const auto& effect : world.post_step_effects) {
+    Json collider;
+    if (const auto* g = dynamic_cast<const Ground*>(effect.get())) {
+      collider["type"] = "ground";
+      collider["y"] = g->y0();
+    } else if (const auto* b = dynamic_cast<const Sphere*>(effect.get())) {
+      collider["type"] = "sphere";
+      collider["centre"] = {b->centre().x(), b->centre().y(), b->centre().z()};
+      collider["radius"] = b->radius();
+    } else {
+      continue;
+    }
+    data["colliders"].push_back(std::move(collider));
   }
-  frames += "]";
-  const std::string json = fmt::format(
-      "{{\"title\":{},\"source\":{},\"particles\":{},\"times\":{},\"kinetic\":{},"
-      "\"potential\":{},\"total\":{},\"surfaces\":[{}],\"springs\":{},\"pins\":{},\"colliders\":[{}"
-      "]"
-      ","
-      "\"frames\":{}}}",
-      json_string(title_), json_string(source_), world.particles.size(), json_array(times_),
-      json_array(kinetic_), json_array(potential_), json_array(total), surfaces,
-      json_array(springs), json_array(pins), colliders, frames);
+  data["frames"] = Json::array();
+  for (const std::vector<float>& frame : positions_)
+    data["frames"].push_back(base64(frame.data(), frame.size() * sizeof(float)));
+  // A title or file name that is not valid UTF-8 gets U+FFFD where it is not, rather than no
+  // page; "</" is escaped so that no string closes the page's <script> element.
+  const std::string json =
+      script_safe_json(data.dump(-1, ' ', false, Json::error_handler_t::replace));
 
   const std::string_view marker = "/*CLOTHLAB_DATA*/";
   const size_t at = kViewerTemplate.find(marker);

@@ -10,6 +10,8 @@
 #include <string>
 #include <vector>
 
+#include <nlohmann/json.hpp>
+
 #include "io/run.hpp"
 #include "scene/scene.hpp"
 
@@ -185,7 +187,17 @@ fps = 10
   const std::string page((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
   CHECK(page.find("/*CLOTHLAB_DATA*/") == std::string::npos);  // the marker was replaced
   CHECK(page.find("\"particles\":1,") != std::string::npos);
-  CHECK(page.find("\"times\":[0,0.1,") != std::string::npos);
+  CHECK(page.find("\"times\":[0.0,0.1,") != std::string::npos);
   CHECK(page.find("a <\\/script> in a title") != std::string::npos);
   CHECK(page.find("a </script> in a title") == std::string::npos);
+  // The page's data, up to the end of its <script> element, is JSON, and the title reads back
+  // as written.
+  const std::string open = "<script id=\"clothlab-data\" type=\"application/json\">";
+  const size_t begin = page.find(open);
+  REQUIRE(begin != std::string::npos);
+  const size_t from = begin + open.size();
+  const auto data = nlohmann::json::parse(page.substr(from, page.find("</script>", from) - from));
+  CHECK(data["title"] == "a </script> in a title must not end the page's script");
+  CHECK(data["particles"] == 1);
+  CHECK(data["frames"].size() == data["times"].size());
 }

@@ -89,7 +89,7 @@ export DEBIAN_FRONTEND=noninteractive
 root=${AUTOGRADER_ROOT:-/autograder}
 apt-get update
 apt-get install -y --no-install-recommends g++ cmake make libeigen3-dev doctest-dev libfmt-dev \
-  libtomlplusplus-dev libcli11-dev bubblewrap
+  libtomlplusplus-dev libcli11-dev nlohmann-json3-dev bubblewrap
 cd "$root/source/clothlab"
 cmake -S . -B build
 cmake --build build --parallel "$(nproc)" --target clothlab grade-kit

@@ -5,7 +5,8 @@
 // path of a grade-kernels-* program, or `clothlab grade`'s sandbox around one: its arguments
 // separated by the character 0x1f), and lives until the grading binary ends. When it dies
 // during a call, the call throws KernelsEnded, whose text starts with "crashed: signal N" for a
-// signal; the grader reads that as the case crashing, as if the kernel had run in this process.
+// signal (app/grade/kernels_crash.hpp); the grader reads that as the case crashing, as if the
+// kernel had run in this process.
 #include <fcntl.h>
 #include <signal.h>
 #include <sys/prctl.h>
@@ -21,6 +22,7 @@
 #include <thread>
 #include <vector>
 
+#include "app/grade/kernels_crash.hpp"
 #include "clothlab/core/not_implemented.hpp"
 #include "kernel_wire.hpp"
 
@@ -79,7 +81,7 @@ class Kernels {
       } else if (code == 127) {
         gone_ = "the kernels program (CLOTHLAB_KERNELS) could not be started" + during;
       } else if (signal != 0) {
-        gone_ = "crashed: signal " + std::to_string(signal) +
+        gone_ = std::string(app::grading::kKernelsCrashed) + std::to_string(signal) +
                 " (in the exercise's code, which runs in a process of its own," + during + ")";
       } else {
         gone_ = "the exercise's code ended its process with exit status " + std::to_string(code) +

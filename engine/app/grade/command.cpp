@@ -1,0 +1,444 @@
+// command.cpp: the `clothlab grade` and `clothlab watch` subcommands (app/grade.hpp): their
+// options, building what is graded (the student's exercises or a submission), grading the cases
+// one by one and writing the reports as they come, and watching the exercise files.
+#include "app/exit_codes.hpp"
+#include "app/grade.hpp"
+#include "app/grade/cases.hpp"
+#include "app/grade/exercises.hpp"
+#include "app/grade/reports.hpp"
+#include "app/grade/text.hpp"
+#include "app/process.hpp"
+#include "app/sandbox.hpp"
+#include "app/submission.hpp"
+
+#include <unistd.h>
+
+#include <fmt/core.h>
+#include <CLI/CLI.hpp>
+
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#include <exception>
+#include <filesystem>
+#include <iostream>
+#include <memory>
+#include <string>
+#include <system_error>
+#include <thread>
+#include <utility>
+#include <vector>
+
+namespace clothlab::app {
+
+using namespace grading;
+
+namespace {
+
+namespace fs = std::filesystem;
+using Clock = std::chrono::steady_clock;
+
+struct Options {
+  std::string impl = "student";
+  std::string exercise;  // "ex01" or "ex01.2"; empty for all
+  bool list = false;
+  double timeout = 10;  // per case [s]
+  std::string results;  // Gradescope results.json
+  std::string junit;
+  bool require_full = false;
+  bool require_zero = false;
+  std::string binary;      // hidden: grade this doctest binary instead of grade-<impl>
+  std::string submission;  // grade the exercise files in this folder
+  std::string scratch;     // where a submission is built; default <dir of clothlab>/grade-scratch
+  double build_timeout = 600;    // [s] for configuring, then for compiling, a submission
+  std::string sandbox = "auto";  // a submission's cases in bubblewrap: auto, on or off
+  bool autolab = false;          // end with Autolab's one-line JSON score summary
+  std::string classroom;         // write a GitHub Classroom workflow here, and grade nothing
+  bool hidden = false;           // also the hidden cases of tests/grade-hidden/ (instructors)
+  std::string exercises;         // hidden: the student's exercise files; default exercises/
+  int rounds = 0;                // watch: stop after this many gradings (0: never; for tests)
+};
+
+// A program of the build folder: the grading binary and the kernels programs are built next to
+// clothlab.
+std::string built_program(const std::string& name) {
+  const fs::path path = fs::path(build_dir()) / name;
+  if (!fs::exists(path)) {
+    fail(kExitBadInput,
+         fmt::format("{} does not exist: build it first with\n  cmake --build build --target {}",
+                     path.string(), name));
+  }
+  return path.string();
+}
+
+bool selected(const Case& c, const std::string& filter) {
+  return filter.empty() || c.exercise == filter || c.exercise.starts_with(filter + ".");
+}
+
+// What the build of a submission took, left out and said, for the report.
+std::string submission_notes(const SubmissionBuild& b) {
+  auto names = [](const std::vector<std::string>& files) {
+    std::string s;
+    for (const std::string& f : files) {
+      if (!s.empty()) s += ", ";
+      s += printable(f);  // names the submission chose
+    }
+    return s;
+  };
+  std::string s;
+  if (!b.taken.empty()) s += "Graded from the submission: " + names(b.taken) + "\n";
+  if (!b.missing.empty())
+    s += "Not in the submission (graded on the shipped stub): " + names(b.missing) + "\n";
+  if (!b.ignored.empty()) s += "Ignored (not an exercise file): " + names(b.ignored) + "\n";
+  if (!b.refused.empty()) s += "Refused (graded on the shipped stub): " + names(b.refused) + "\n";
+  if (!b.built) s += "\nThe submission does not compile:\n" + indent(b.first_error, "  ") + "\n";
+  return s + "\n";
+}
+
+std::string default_scratch() {
+  return (fs::path(grade_kit_dir()).parent_path() / "grade-scratch").string();
+}
+
+// Where the student's own exercises are built for grading, kept from one grading to the next.
+std::string own_scratch() {
+  return (fs::path(grade_kit_dir()).parent_path() / "grade-own").string();
+}
+
+// A case that cannot run because what it would grade did not compile: `what` says so ("the
+// submission does not compile"), `error` is the compiler's first error.
+void mark_not_compiled(Case& c, const std::string& what, const std::string& error) {
+  c.done = true;
+  c.not_compiled = true;
+  c.status = "not compiled";
+  c.message = what + ":\n" + error;
+  c.diagnosis = error.substr(0, error.find('\n'));
+}
+
+// "01_particles_and_euler.cpp" holds the exercises of lesson 01: ex01.1, ex01.2, ...
+bool in_file(const Case& c, const std::string& file) {
+  const std::string lesson = "ex" + file.substr(0, file.find('_'));
+  return c.exercise == lesson || c.exercise.starts_with(lesson + ".");
+}
+
+// The student's own grading: exercises/ built afresh with the kit (only what changed is
+// recompiled), a file that does not compile standing aside for its stub. Returns the binary to
+// grade, or "" when nothing could be built; marks the cases that cannot be graded.
+std::string build_own(const Options& o, std::vector<Case>& cases, std::string& notes, bool colour,
+                      std::shared_ptr<void>& hold) {
+  const std::string dir =
+      o.exercises.empty() ? (fs::path(CLOTHLAB_SOURCE_DIR) / "exercises").string() : o.exercises;
+  if (colour) fmt::print("building your exercises ...");
+  std::fflush(stdout);
+  SubmissionBuild build;
+  try {
+    build =
+        build_submission(dir, o.scratch.empty() ? own_scratch() : o.scratch, o.build_timeout, true);
+  } catch (const std::exception& e) {
+    fail(kExitBadInput, e.what());
+  }
+  if (colour) fmt::print("\r\033[K");
+  hold = build.hold;  // the scratch folder stays this grader's while the binary is graded
+  for (const std::string& why : build.refused)
+    notes += "Refused, graded on its shipped stub: exercises/" + printable(why) + "\n";
+  if (!build.built) {
+    if (g_interrupted) return "";
+    build.first_error = printable(build.first_error);
+    notes += "Your exercises do not build:\n" + indent(build.first_error, "  ") + "\n\n";
+    for (Case& c : cases)
+      mark_not_compiled(c, "the exercises do not build", build.first_error);
+    return "";
+  }
+  for (SubmissionBuild::Broken& broken : build.broken) {
+    broken.error = printable(broken.error);
+    for (Case& c : cases) {
+      if (!in_file(c, broken.name)) continue;
+      mark_not_compiled(c, "exercises/" + broken.name + " does not compile", broken.error);
+      c.broken_file = true;
+    }
+  }
+  return build.binary;
+}
+
+// notes: what the grader says before the table (how a submission was built), also shown at the
+// top of Gradescope's results.
+void write_reports(const Options& o, const std::vector<Case>& cases, double seconds,
+                   const std::string& notes) {
+  if (!o.results.empty())
+    write_file(o.results, gradescope_json(cases, seconds, notes + summary(cases, false)));
+  if (!o.junit.empty()) write_file(o.junit, junit_xml(cases, seconds));
+}
+
+void grade(const Options& o) {
+  const bool submission = !o.submission.empty();
+  // The student's own exercises, built before they are graded, so that a grade is never that
+  // of a binary older than the files.
+  const bool own = !submission && o.binary.empty() && o.impl == "student";
+  const bool grading = !o.list && o.classroom.empty();
+  check_report_path("--results", o.results);
+  check_report_path("--junit", o.junit);
+  check_report_path("--classroom", o.classroom);
+  adopt_orphans();  // a process a case leaves behind is handed to the grader, which ends it
+  if ((submission || own) &&
+      (grading || !fs::exists(fs::path(grade_kit_dir()).parent_path() / "grade-cases"))) {
+    const std::string why = update_grade_kit(o.build_timeout);
+    if (!why.empty()) fail(kExitBadInput, why);
+  }
+  if (o.impl == "reference" && !CLOTHLAB_HAVE_SOLUTIONS && !submission && o.binary.empty())
+    fail(kExitBadInput, "this is a student release: it has no reference solutions to grade");
+  // The grading binary, and the kernels it calls: those of --impl, or those the kit builds below
+  // from a submission or the student's exercises. (--binary: a binary with code of its own.)
+  Grader grader;
+  grader.binary = o.binary.empty() ? built_program("grade-cases") : o.binary;
+  if (!fs::exists(grader.binary)) fail(kExitBadInput, grader.binary + " does not exist");
+  if (!submission && !own && o.binary.empty())
+    grader.kernels = built_program("grade-kernels-" + o.impl);
+  std::vector<Case> cases = list_cases(grader.binary);
+  // The hidden cases count only when an instructor asks for them: a student's grade has the
+  // cases and points the lessons quote.
+  if (!o.hidden) std::erase_if(cases, [](const Case& c) { return c.hidden_test; });
+  if (!o.exercise.empty()) {
+    std::erase_if(cases, [&](const Case& c) { return !selected(c, o.exercise); });
+    if (cases.empty()) fail(kExitBadInput, "no grading case belongs to exercise " + o.exercise);
+  }
+  if (o.list) {
+    print_points_table(cases);
+    return;
+  }
+  if (!o.classroom.empty()) {
+    write_file(o.classroom, classroom_workflow(cases));
+    fmt::print("wrote {}\n", o.classroom);
+    return;
+  }
+
+  const bool terminal = isatty(STDOUT_FILENO) != 0;
+  const char* no_color = std::getenv("NO_COLOR");
+  const bool colour = terminal && (no_color == nullptr || *no_color == '\0');
+
+  g_interrupted = 0;
+  InterruptGuard guard;
+  const auto start = Clock::now();
+  auto elapsed = [&] { return std::chrono::duration<double>(Clock::now() - start).count(); };
+  std::string notes;
+  bool compiled = true;
+  std::shared_ptr<void> hold;  // the scratch folder's lock, while its binary is graded
+  // A submission is compiled, and its kernels run, as nobody (when the grader is root) and in the
+  // sandbox where it works (sandbox.hpp); where it does not, the grader says loudly what the
+  // submission can then do.
+  Confinement confinement;
+  if (submission && o.sandbox != "off") {
+    std::string warnings;
+    confinement = confine(o.sandbox, kit_inputs(), warnings);
+    std::cout << std::flush;
+    if (!warnings.empty()) std::cerr << "clothlab grade: warning: " << warnings;
+    if (confinement.bwrap.empty() && o.sandbox == "on")
+      fail(kExitBadInput,
+           "--sandbox on: bubblewrap (bwrap) is not installed or cannot make namespaces here");
+    if (confinement.bwrap.empty()) {
+      std::cerr << "clothlab grade: WARNING: no sandbox (bubblewrap is not installed, or cannot "
+                   "make namespaces here): the submission's code runs as "
+                << (confinement.user.empty() ? "this user" : "the user nobody")
+                << " and can read whatever that user can, the solutions and hidden tests "
+                   "included. Install bubblewrap (Debian: apt-get install bubblewrap), or grade on "
+                   "a machine that holds nothing else.\n";
+    }
+  }
+  if (submission) {
+    notes = "Submission: " + o.submission + "\n";
+    write_reports(o, cases, elapsed(), notes);  // so even an interrupted build leaves results
+    if (colour) fmt::print("building {} ...", o.submission);
+    std::fflush(stdout);
+    SubmissionBuild build;
+    try {
+      build = build_submission(o.submission, o.scratch.empty() ? default_scratch() : o.scratch,
+                               o.build_timeout, false, o.sandbox != "off" ? &confinement : nullptr);
+    } catch (const std::exception& e) {
+      fail(kExitBadInput, e.what());
+    }
+    if (colour) fmt::print("\r\033[K");
+    hold = build.hold;
+    build.first_error = printable(build.first_error);
+    notes += submission_notes(build);
+    fmt::print("{}", notes);
+    compiled = build.built;
+    if (compiled) {
+      grader.kernels = build.binary;
+    } else if (!g_interrupted) {
+      for (Case& c : cases)
+        mark_not_compiled(c, "the submission does not compile", build.first_error);
+    }
+  }
+  if (own) {
+    grader.kernels = build_own(o, cases, notes, colour, hold);
+    compiled = !grader.kernels.empty();
+    fmt::print("{}", notes);
+  }
+  if (submission && o.sandbox != "off") grader.sandbox = confinement.kernels(grader.kernels);
+  for (std::size_t i = 0; compiled && i < cases.size() && !g_interrupted; ++i) {
+    if (cases[i].done) continue;  // not compiled
+    if (colour) fmt::print("\r\033[K[{}/{}] {}", i + 1, cases.size(), cases[i].name.substr(0, 70));
+    std::fflush(stdout);
+    run_case(grader, cases[i], o.timeout);
+    // After every case, so an interrupted run leaves results.
+    write_reports(o, cases, elapsed(), notes);
+  }
+  if (colour) fmt::print("\r\033[K");
+  std::fflush(stdout);
+
+  fmt::print("{}", summary(cases, colour));
+  write_reports(o, cases, elapsed(), notes);
+  if (g_interrupted)
+    fail(kExitInterrupted, "interrupted: the results of the cases run so far are written");
+  if (o.autolab) fmt::print("{}\n", autolab_line(cases));
+
+  if (o.require_full) {
+    const auto failed =
+        std::count_if(cases.begin(), cases.end(), [](const Case& c) { return !c.passed; });
+    if (failed > 0)
+      fail(kExitFailed,
+           fmt::format("--require-full: {} of {} cases did not pass", failed, cases.size()));
+  }
+  if (o.require_zero) {
+    std::string scored;
+    for (const Exercise& x : by_exercise(cases)) {
+      if (x.earned > 0)
+        scored += fmt::format("\n  {} scores {} / {} points", x.id, x.earned, x.max);
+    }
+    if (!scored.empty()) {
+      fail(kExitFailed,
+           "--require-zero: these exercises score points, so their tests cannot fail:" + scored);
+    }
+  }
+}
+
+// The exercise files of the student, and when each last changed: what `watch` waits on.
+using Snapshot = std::vector<std::pair<std::string, fs::file_time_type>>;
+Snapshot exercise_files(const fs::path& dir) {
+  Snapshot files;
+  std::error_code ec;
+  for (const auto& entry : fs::directory_iterator(dir, ec)) {
+    if (entry.path().extension() != ".cpp") continue;
+    files.emplace_back(entry.path().filename().string(), entry.last_write_time(ec));
+  }
+  std::sort(files.begin(), files.end());
+  return files;
+}
+
+// `clothlab watch`: grades, then grades again each time an exercise file is saved.
+void watch(Options o) {
+  const fs::path dir =
+      o.exercises.empty() ? fs::path(CLOTHLAB_SOURCE_DIR) / "exercises" : fs::path(o.exercises);
+  const bool terminal = isatty(STDOUT_FILENO) != 0;
+  const std::string what = o.exercise.empty() ? "every exercise" : o.exercise;
+  InterruptGuard guard;  // Ctrl-C while waiting ends the watch
+  std::string changed;
+  for (int round = 1;; ++round) {
+    if (terminal) fmt::print("\033[2J\033[H");  // a clear screen for each grading
+    fmt::print("clothlab watch: {}, graded again each time you save a file in {}/{}\n\n", what,
+               relative_path(dir.string()), changed.empty() ? "" : " (" + changed + " changed)");
+    std::fflush(stdout);
+    try {
+      grade(o);
+    } catch (const CLI::RuntimeError& e) {
+      if (e.get_exit_code() == kExitInterrupted) throw;  // interrupted while grading
+      // Anything else the grader could not do is said; the next save may mend it.
+    }
+    if (o.rounds > 0 && round >= o.rounds) return;
+    fmt::print("\nwaiting for a change in {}/ (Ctrl-C to stop)\n", relative_path(dir.string()));
+    std::fflush(stdout);
+    const Snapshot before = exercise_files(dir);
+    Snapshot now = before;
+    while (now == before) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(250));
+      if (g_interrupted) {
+        fmt::print("stopped\n");
+        return;
+      }
+      now = exercise_files(dir);
+    }
+    changed.clear();
+    for (const auto& file : now) {
+      if (std::find(before.begin(), before.end(), file) == before.end())
+        changed += (changed.empty() ? "" : ", ") + file.first;
+    }
+    // An editor may write a file in more than one go.
+    std::this_thread::sleep_for(std::chrono::milliseconds(150));
+  }
+}
+
+}  // namespace
+
+void add_watch_command(CLI::App& app) {
+  auto o = std::make_shared<Options>();
+  CLI::App* cmd = app.add_subcommand(
+      "watch", "Grade your exercises, then again each time you save one (Ctrl-C to stop)");
+  cmd->add_option("exercise", o->exercise, "Watch one lesson (ex01) or one exercise (ex01.2)")
+      ->check(CLI::Validator(
+          [](std::string& s) {
+            return is_exercise_id(s, true) ? std::string() : "expected exNN or exNN.k";
+          },
+          "exNN[.k]"));
+  cmd->add_option("--timeout", o->timeout, "Seconds a case may run before it is stopped")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
+  cmd->add_option("--exercises", o->exercises, "The folder of exercise files")->group("");
+  cmd->add_option("--scratch", o->scratch, "Where to build them")->group("");
+  cmd->add_option("--rounds", o->rounds, "Stop after this many gradings")->group("");
+  cmd->callback([o] { watch(*o); });
+}
+
+void add_grade_command(CLI::App& app) {
+  auto o = std::make_shared<Options>();
+  CLI::App* cmd = app.add_subcommand("grade", "Run the grading tests and score each exercise");
+  cmd->add_option("--impl", o->impl,
+                  "Which kernels to grade: your exercises (built first, so the grade is always "
+                  "that of the files as saved), the reference or the shipped stubs")
+      ->check(CLI::IsMember({"student", "reference", "stubs"}))
+      ->capture_default_str();
+  cmd->add_flag("--hidden", o->hidden,
+                "Also the hidden cases of tests/grade-hidden/ (for instructors: a student's "
+                "grade leaves them out)");
+  cmd->add_option("--exercises", o->exercises, "Grade the exercise files in this folder as yours")
+      ->group("");
+  cmd->add_option("--exercise", o->exercise, "Grade one lesson (ex01) or one exercise (ex01.2)")
+      ->check(CLI::Validator(
+          [](std::string& s) {
+            return is_exercise_id(s, true) ? std::string() : "expected exNN or exNN.k";
+          },
+          "exNN[.k]"));
+  cmd->add_flag("--list", o->list, "Print the points table without running anything");
+  cmd->add_option("--timeout", o->timeout, "Seconds a case may run before it is stopped")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
+  cmd->add_option("--results", o->results, "Write Gradescope results.json here");
+  cmd->add_option("--junit", o->junit, "Write JUnit XML here");
+  cmd->add_flag("--require-full", o->require_full, "Exit with status 1 unless every case passed");
+  cmd->add_flag("--require-zero", o->require_zero,
+                "Exit with status 1 unless every exercise scored zero");
+  CLI::Option* binary = cmd->add_option("--binary", o->binary,
+                                        "Grade this doctest binary (built with grade_main.cpp)")
+                            ->group("");
+  cmd->add_option("--submission", o->submission,
+                  "Grade the exercise files in this folder (a student's submission), built in a "
+                  "scratch folder")
+      ->excludes(binary);
+  cmd->add_option("--scratch", o->scratch,
+                  "Where to build a submission (default: grade-scratch next to clothlab; "
+                  "grade-own for your exercises)");
+  cmd->add_option("--build-timeout", o->build_timeout,
+                  "Seconds configuring, then compiling, a submission may take")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
+  cmd->add_option("--sandbox", o->sandbox,
+                  "Run a submission's cases in bubblewrap: auto (where it works, else warn), on "
+                  "(refuse to grade without it) or off")
+      ->check(CLI::IsMember({"auto", "on", "off"}))
+      ->capture_default_str();
+  cmd->add_flag("--autolab", o->autolab,
+                "End with Autolab's one-line JSON summary of the scores per exercise");
+  cmd->add_option("--classroom", o->classroom,
+                  "Write a GitHub Classroom workflow (one step per exercise) here; grade nothing");
+  cmd->callback([o] { grade(*o); });
+}
+
+}  // namespace clothlab::app
