@@ -73,9 +73,11 @@ bool FastEngine::prepare(const World& world) {
   bool any = false;
   for (size_t e = 0; e < effects.size(); ++e) {
     Force& force = forces_[e];
-    if (force.effect != effects[e].get()) {
-      force.effect = effects[e].get();
-      force.fast = fast_force(*force.effect);
+    const ForceEffect& effect = *effects[e];
+    if (force.effect != &effect || *force.type != typeid(effect)) {
+      force.effect = &effect;
+      force.type = &typeid(effect);
+      force.fast = fast_force(effect);
     }
     force.on = force.fast && force.fast->prepare(world.particles);
     any = any || force.on;

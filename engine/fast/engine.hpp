@@ -32,6 +32,7 @@
 #include <functional>
 #include <memory>
 #include <string>
+#include <typeinfo>
 #include <vector>
 
 #include "clothlab/core/backend.hpp"
@@ -95,9 +96,13 @@ class FastEngine final : public Backend {
             const MoveRange* move = nullptr, PassChecks* checks = nullptr);
 
   struct Force {
-    const ForceEffect* effect = nullptr;  // the world's effect at this place
-    std::unique_ptr<FastForce> fast;      // its fast form, or null
-    bool on = false;                      // it takes the current evaluation
+    // The world's effect at this place, and its type: an effect removed and another made at the
+    // same address is seen as new unless it is of the same type (and then the fast form reads
+    // the new one, and checks its version).
+    const ForceEffect* effect = nullptr;
+    const std::type_info* type = nullptr;
+    std::unique_ptr<FastForce> fast;  // its fast form, or null
+    bool on = false;                  // it takes the current evaluation
   };
   std::vector<Force> forces_;
   struct Contact {  // a leading post-step effect that rides along in a step's pass

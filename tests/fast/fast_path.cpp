@@ -359,6 +359,30 @@ TEST_CASE("fast path: effects without a fast path, between and after those with 
   }
 }
 
+TEST_CASE("fast path: an effect replaced between steps is never summed as the one it replaced") {
+  // Damping is destroyed and a pull made in its place, likely at the same address (the same
+  // small allocation): the fast engine must see a new effect, of another type, and leave it to
+  // its add_forces, as the lecture's path does.
+  const auto replace_damping = [](clothlab::World& w) {
+    for (auto& effect : w.force_effects) {
+      if (effect->name() != "damping") continue;
+      effect.reset();
+      effect = std::make_unique<PullToOrigin>();
+    }
+  };
+  std::vector<clothlab::Scene> scenes;
+  for (bool fast : {false, true}) {
+    clothlab::Scene scene = run(cloth(""), fast, 1, 20);
+    replace_damping(scene.world);
+    for (int step = 0; step < 40; ++step)
+      scene.world.step(scene.dt);
+    scenes.push_back(std::move(scene));
+  }
+  CHECK(engine_of(scenes[1].world).plan().find("pull-") != std::string::npos);
+  CHECK(identical(scenes[1].world.particles.x, scenes[0].world.particles.x));
+  CHECK(identical(scenes[1].world.particles.v, scenes[0].world.particles.v));
+}
+
 TEST_CASE("fast path: the Euler methods move particles in the pass that sums their forces") {
   // Without buoyancy the last effect has a fast path, so each thread copies its particles'
   // forces back and moves them, 512 at a time, in the pass that summed the forces
