@@ -108,6 +108,10 @@ void ViewerRecorder::write(const World& world, const std::filesystem::path& html
       collider["type"] = "sphere";
       collider["centre"] = {b->centre().x(), b->centre().y(), b->centre().z()};
       collider["radius"] = b->radius();
+    } else if (const auto* plane = dynamic_cast<const Plane*>(effect.get())) {
+      collider["type"] = "plane";
+      collider["point"] = {plane->point().x(), plane->point().y(), plane->point().z()};
+      collider["normal"] = {plane->normal().x(), plane->normal().y(), plane->normal().z()};
     } else {
       continue;
     }

@@ -341,8 +341,21 @@ void read_buoyancy(SceneTable& t, Scene& scene) {
   const double rho = t.number("rho", Range::positive("kg/m^3"), 1000.0);  // water
   const double volume = t.required_number("volume", Range::positive("m^3"));
   const double surface = t.number("surface", Range::any("m"), 0.0);
-  const double g = t.number("g", Range::positive("m/s^2"), 9.8);
-  scene.world.force_effects.push_back(std::make_unique<Buoyancy>(rho, volume, surface, g));
+  // Against the scene's gravity when it has one ([gravity] is read first), else against -y; `g`
+  // sets the strength alone.
+  Vec3 down(0.0, -1.0, 0.0);
+  double strength = 9.8;
+  for (const auto& effect : scene.world.force_effects) {
+    if (const auto* gravity = dynamic_cast<const UniformGravity*>(effect.get())) {
+      const double norm = gravity->g().norm();
+      if (norm > 0.0 && std::isfinite(norm)) {
+        down = gravity->g() / norm;
+        strength = norm;
+      }
+    }
+  }
+  const double g = t.number("g", Range::positive("m/s^2"), strength);
+  scene.world.force_effects.push_back(std::make_unique<Buoyancy>(rho, volume, surface, g * down));
 }
 
 // [gravity]: uniform gravity, f = m g (lesson 01).
@@ -464,6 +477,19 @@ void read_sphere(SceneTable& t, Scene& scene) {
   const double radius = t.required_number("radius", Range::positive("m"));
   scene.world.post_step_effects.push_back(
       std::make_unique<Sphere>(centre, radius, read_material(t)));
+}
+
+// [[plane]]: a plane through a point with an outward normal, solid on the other side: a ramp
+// (lesson 05).
+void read_plane(SceneTable& t, Scene& scene) {
+  const Vec3 point = t.required_vec3("point", "m");
+  const Vec3 normal = t.required_vec3("normal", "");
+  if (normal.cwiseAbs().maxCoeff() == 0.0) {
+    t.fail("normal",
+           "normal = [0, 0, 0] has no direction; expected the plane's outward normal, "
+           "e.g. [0, 1, 0] for a floor");
+  }
+  scene.world.post_step_effects.push_back(std::make_unique<Plane>(point, normal, read_material(t)));
 }
 
 // [plasticity]: springs whose rest length yields past an elastic limit (lesson 06).
@@ -588,6 +614,8 @@ constexpr std::array kKinds = {
                    "[ground] with y, e, mu_s and mu_d", read_ground},
     SceneTableKind{"sphere", false, false, "centre radius e mu_s mu_d rest_speed",
                    "[sphere] with centre and radius", read_sphere},
+    SceneTableKind{"plane", true, false, "point normal e mu_s mu_d rest_speed",
+                   "[[plane]] with point and normal", read_plane},
     SceneTableKind{"plasticity", false, false, "yield_strain flow_rate max_strain",
                    "[plasticity] with yield_strain", read_plasticity},
     SceneTableKind{"tearing", false, false, "strain max_per_step", "[tearing] with strain",

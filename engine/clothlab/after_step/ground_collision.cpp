@@ -1,5 +1,6 @@
 #include "clothlab/after_step/ground_collision.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 #include "clothlab/core/world.hpp"
@@ -8,16 +9,49 @@ namespace clothlab {
 
 namespace {
 
-// The response the effects share: below rest_speed, an approach does not bounce (e = 0), so a
-// particle resting under gravity is not relaunched by g dt every step.
+// The response the effects share. Only an arrival bounces. A particle that began the step on
+// the surface, not coming at it faster than rest_speed beyond what this step's own forces added,
+// is in resting contact: pushed in by this step's forces, with nothing to bounce from. An
+// approach slower than rest_speed does not bounce either. For both, e = 0: so a particle resting
+// under gravity is not relaunched by g dt every step, however large dt is.
 PointState respond(const Vec3& r, const Vec3& v, const Vec3& n, double depth,
-                   const ContactMaterial& m) {
+                   const ContactMaterial& m, bool began_touching, const Vec3& v0) {
   const double approach = -v.dot(n);  // [m/s], > 0 when moving into the surface
-  const double e = approach < m.rest_speed ? 0.0 : m.e;
+  const double approach0 = -v0.dot(n);
+  const bool resting =
+      began_touching && approach0 <= m.rest_speed + std::max(0.0, approach - approach0);
+  const double e = resting || approach < m.rest_speed ? 0.0 : m.e;
   return collision_response(r, v, n, depth, e, m.mu_s, m.mu_d);
 }
 
+// True when the response left no tangential velocity: static friction held the particle (up to
+// the rounding of v - (v . n) n). A particle that slides keeps some; one that arrived without
+// any is held too.
+bool held(const Vec3& v_before, const Vec3& v_after, const Vec3& n) {
+  const double before = (v_before - v_before.dot(n) * n).norm();
+  const double after = (v_after - v_after.dot(n) * n).norm();
+  return after <= 1e-9 * (before + v_after.norm());
+}
+
+// Where the step's straight path from x0 (height0 above the surface, or inside if negative) to x1
+// (depth1 > 0 inside) met the surface: x0 itself for a particle that began on or in it.
+Vec3 where_it_met(const Vec3& x0, const Vec3& x1, double height0, double depth1) {
+  const double s = height0 > 0.0 ? height0 / (height0 + depth1) : 0.0;
+  return x0 + s * (x1 - x0);
+}
+
+// Whether a particle that began the step at x0, height0 [m] above the surface, was touching it:
+// on it up to the rounding of its coordinates, or inside.
+bool touching(double height0, const Vec3& x0) {
+  return height0 <= 1e-12 * (1.0 + x0.lpNorm<Eigen::Infinity>());
+}
+
 }  // namespace
+
+void StepStart::record(const World& world) {
+  x_ = world.particles.x;
+  v_ = world.particles.v;
+}
 
 void Ground::apply(World& world, double /*dt*/) {
   collide(world.particles, 0, world.particles.size());
@@ -38,9 +72,20 @@ void Ground::apply(World& world, double /*dt*/) {
       p.v(2, i) *= 1.0 - friction_;
       continue;
     }
-    const PointState out = respond(p.x.col(i), p.v.col(i), up, depth, material_);
+    const Vec3 x1 = p.x.col(i);
+    const Vec3 v1 = p.v.col(i);
+    const bool known = start_.known(p);
+    const double height0 = known ? start_.x(i).y() - y0_ : 1.0;  // where the step began
+    const PointState out =
+        respond(x1, v1, up, depth, material_, known && touching(height0, start_.x(i)),
+                known ? start_.v(i) : v1);
     p.x.col(i) = out.r;
     p.v.col(i) = out.v;
+    if (known && held(v1, out.v, up)) {
+      const Vec3 met = where_it_met(start_.x(i), x1, height0, depth);
+      p.x(0, i) = met.x();
+      p.x(2, i) = met.z();
+    }
     p.x(1, i) = std::max(p.x(1, i), y0_);  // exactly on the ground, whatever the rounding
   }
 }
@@ -56,9 +101,46 @@ void Sphere::apply(World& world, double /*dt*/) {
     if (!(distance < radius_) || p.inv_m[i] == 0.0) continue;
     // The outward normal; a particle exactly at the centre is pushed out upward.
     const Vec3 n = distance > 0.0 ? Vec3(d / distance) : Vec3::UnitY();
-    const PointState out = respond(p.x.col(i), p.v.col(i), n, radius_ - distance, material_);
+    const Vec3 x1 = p.x.col(i);
+    const Vec3 v1 = p.v.col(i);
+    const bool known = start_.known(p);
+    const double height0 = known ? (start_.x(i) - centre_).norm() - radius_ : 1.0;
+    const PointState out =
+        respond(x1, v1, n, radius_ - distance, material_, known && touching(height0, start_.x(i)),
+                known ? start_.v(i) : v1);
     p.x.col(i) = out.r;
     p.v.col(i) = out.v;
+    if (known && held(v1, out.v, n)) {
+      const Vec3 met = where_it_met(start_.x(i), x1, height0, radius_ - distance);
+      const Vec3 from_centre = met - centre_;
+      const double r = from_centre.norm();
+      if (r > 0.0) p.x.col(i) = centre_ + radius_ / r * from_centre;
+    }
+  }
+}
+
+void Plane::apply(World& world, double /*dt*/) {
+  collide(world.particles, 0, world.particles.size());
+}
+
+[[gnu::flatten]] void Plane::collide(Particles& p, Index begin, Index end) const {
+  for (Index i = begin; i < end; ++i) {
+    const Vec3 x1 = p.x.col(i);
+    const double depth = -(x1 - point_).dot(normal_);
+    if (!(depth > 0.0) || p.inv_m[i] == 0.0) continue;
+    const Vec3 v1 = p.v.col(i);
+    const bool known = start_.known(p);
+    const double height0 = known ? (start_.x(i) - point_).dot(normal_) : 1.0;
+    const PointState out =
+        respond(x1, v1, normal_, depth, material_, known && touching(height0, start_.x(i)),
+                known ? start_.v(i) : v1);
+    Vec3 x = out.r;
+    p.v.col(i) = out.v;
+    if (known && held(v1, out.v, normal_)) x = where_it_met(start_.x(i), x1, height0, depth);
+    // On the plane, whatever the rounding: a point it left below is lifted onto it.
+    const double below = -(x - point_).dot(normal_);
+    if (below > 0.0) x += below * normal_;
+    p.x.col(i) = x;
   }
 }
 

@@ -12,7 +12,15 @@
 //                    static: if |v_t| <= mu_s j the particle sticks, v_t' = 0;
 //                    dynamic: otherwise it slides on, v_t' = v_t (1 - mu_d j / |v_t|).
 //
-// Friction only ever slows the sliding, never reverses it, so it cannot add energy. The
+// Friction only ever slows the sliding, never reverses it, so it cannot add energy.
+//
+// Sticking holds positions too. The step has already carried the particle along the surface
+// before the contact is found; a particle that static friction holds is put back where its path
+// met the surface (where it stood, for a particle resting on it), so a block that should rest on
+// a slope rests, at any dt and with any integrator, instead of creeping by g_t dt^2 a step. The
+// contact effects record the positions each step starts from for this (before_step).
+//
+// The
 // lecture's simpler version (reflect, v.y = -e v.y, v.x and v.z scaled by 1 - friction) is kept
 // beside it as model = "simple", so a lesson can compare the two.
 #pragma once
@@ -37,6 +45,22 @@ struct ContactMaterial {
   double rest_speed = 0.1;  // [m/s] slower approaches do not bounce: resting contact stays calm
 };
 
+// The positions and velocities the particles had when the step began, which a contact effect
+// records: to tell a particle resting on the surface from one arriving at it, and to put a
+// particle static friction holds back where its path met the surface.
+class StepStart {
+ public:
+  void record(const World& world);
+  // Where particle i was when the step began; false when it is not known (the effect was applied
+  // outside World::step, or the particles changed in number since).
+  bool known(const Particles& p) const { return x_.cols() == p.size(); }
+  Vec3 x(Index i) const { return x_.col(i); }
+  Vec3 v(Index i) const { return v_.col(i); }
+
+ private:
+  Matrix3X x_, v_;
+};
+
 // The ground plane y = y0, solid below.
 class Ground final : public PostStepEffect {
  public:
@@ -44,6 +68,7 @@ class Ground final : public PostStepEffect {
   Ground(double y0, const ContactMaterial& material, Model model, double friction)
       : y0_(y0), material_(material), model_(model), friction_(friction) {}
   std::string_view name() const override { return "ground"; }
+  void before_step(const World& world) override { start_.record(world); }
   void apply(World& world, double dt) override;
   // apply's loop on particles [begin, end) only: each particle is pushed out from its own state
   // alone, so ranges may be taken apart (and by different threads at once).
@@ -55,6 +80,30 @@ class Ground final : public PostStepEffect {
   ContactMaterial material_;
   Model model_;
   double friction_;  // the simple model's tangential loss per contact, 0 to 1
+  StepStart start_;
+};
+
+// A plane through `point` with outward unit normal `normal`, solid on the other side: a ramp.
+// The ground is the plane through (0, y0, 0) with normal +y.
+class Plane final : public PostStepEffect {
+ public:
+  // `normal` need not be of unit length; it must not be zero.
+  Plane(const Vec3& point, const Vec3& normal, const ContactMaterial& material)
+      : point_(point),
+        normal_((normal / normal.cwiseAbs().maxCoeff()).normalized()),  // no overflow in |normal|
+        material_(material) {}
+  std::string_view name() const override { return "plane"; }
+  void before_step(const World& world) override { start_.record(world); }
+  void apply(World& world, double dt) override;
+  void collide(Particles& p, Index begin, Index end) const;
+  const Vec3& point() const { return point_; }
+  const Vec3& normal() const { return normal_; }
+
+ private:
+  Vec3 point_;   // [m]
+  Vec3 normal_;  // outward unit normal
+  ContactMaterial material_;
+  StepStart start_;
 };
 
 // A solid sphere the cloth can drape over.
@@ -63,6 +112,7 @@ class Sphere final : public PostStepEffect {
   Sphere(const Vec3& centre, double radius, const ContactMaterial& material)
       : centre_(centre), radius_(radius), material_(material) {}
   std::string_view name() const override { return "sphere"; }
+  void before_step(const World& world) override { start_.record(world); }
   void apply(World& world, double dt) override;
   // apply's loop on particles [begin, end) only (as Ground::collide).
   void collide(Particles& p, Index begin, Index end) const;
@@ -73,6 +123,7 @@ class Sphere final : public PostStepEffect {
   Vec3 centre_;    // [m]
   double radius_;  // [m]
   ContactMaterial material_;
+  StepStart start_;
 };
 
 }  // namespace clothlab

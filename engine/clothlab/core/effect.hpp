@@ -84,6 +84,11 @@ class PostStepEffect {
   virtual ~PostStepEffect() = default;
   virtual std::string_view name() const = 0;
 
+  // Called at the start of every step, before anything moves. An effect that needs the state the
+  // step starts from records it here: a contact needs where each particle was, so that static
+  // friction can hold a particle where it stood (ground_collision.hpp).
+  virtual void before_step(const World& /*world*/) {}
+
   // Applies the effect once the integrator has advanced the particles by dt [s]. It gets the
   // whole world: some post-step effects change more than particles (tearing removes springs
   // and triangles).

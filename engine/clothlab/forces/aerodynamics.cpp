@@ -29,16 +29,17 @@ void FluidDrag::add_forces(const Particles& p, const Matrix3X& /*x*/, const Matr
 
 void Buoyancy::add_forces(const Particles& p, const Matrix3X& x, const Matrix3X& /*v*/,
                           Matrix3X& f) const {
-  const double lift = rho_ * volume_ * g_;  // weight of the displaced fluid [N]
+  const Vec3 lift = rho_ * volume_ * g_ * up_;  // weight of the displaced fluid, upward [N]
   for (Index i = 0; i < p.size(); ++i) {
-    if (x(1, i) < surface_) f(1, i) += lift;
+    if (x.col(i).dot(up_) < surface_) f.col(i) += lift;
   }
 }
 
 double Buoyancy::potential_energy(const Particles& p, const Matrix3X& x) const {
   double energy = 0.0;
   for (Index i = 0; i < p.size(); ++i) {
-    if (x(1, i) < surface_) energy -= rho_ * volume_ * g_ * (surface_ - x(1, i));
+    const double height = x.col(i).dot(up_);
+    if (height < surface_) energy += rho_ * volume_ * g_ * (surface_ - height);
   }
   return energy;
 }

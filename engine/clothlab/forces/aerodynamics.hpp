@@ -96,17 +96,21 @@ class FluidDrag final : public ForceEffect {
   Vec3 v_air_;   // fluid velocity [m/s]
 };
 
-// Buoyancy (game-physics lecture): a particle below the fluid's surface y = surface is pushed up
-// with the weight of the fluid it displaces, rho V g. Particles are points here, so each is
-// either fully under (force rho V g) or not at all.
+// Buoyancy (game-physics lecture): a particle below the fluid's surface is pushed against gravity
+// with the weight of the fluid it displaces, rho V |g|. The surface is the plane at height
+// `surface` measured along up = -g/|g| (y = surface for gravity along -y). Particles are points
+// here, so each is either fully under (force rho V |g| up) or not at all.
 class Buoyancy final : public ForceEffect {
  public:
-  Buoyancy(double rho, double volume, double surface, double g)
-      : rho_(rho), volume_(volume), surface_(surface), g_(g) {}
+  // g: the gravitational acceleration [m/s^2], a vector (not zero).
+  Buoyancy(double rho, double volume, double surface, const Vec3& g)
+      : rho_(rho), volume_(volume), surface_(surface), g_(g.norm()), up_(-g / g.norm()) {}
   std::string_view name() const override { return "buoyancy"; }
   void add_forces(const Particles& p, const Matrix3X& x, const Matrix3X& v,
                   Matrix3X& f) const override;
-  // The fluid's push is conservative: U = -rho V g (surface - y) below the surface, 0 above.
+  // The fluid's push is conservative: U = rho V |g| (surface - h) below the surface, where
+  // h = x . up is the particle's height, and 0 above: a particle held under stores the energy
+  // the fluid would give it rising to the surface, so -dU/dh = rho V |g| is the lift.
   double potential_energy(const Particles& p, const Matrix3X& x) const override;
   double released_energy(const Particles& p, const Matrix3X& x0, const Matrix3X& x) const override {
     return std::abs(potential_energy(p, x) - potential_energy(p, x0));
@@ -115,12 +119,14 @@ class Buoyancy final : public ForceEffect {
   double energy_scale(const Particles& p, const Matrix3X& /*x*/, double size) const override {
     return static_cast<double>(p.size()) * rho_ * volume_ * g_ * size;
   }
+  const Vec3& up() const { return up_; }
 
  private:
   double rho_;      // fluid density [kg/m^3]
   double volume_;   // volume each particle displaces [m^3]
-  double surface_;  // height of the fluid's surface [m]
+  double surface_;  // height of the fluid's surface along up [m]
   double g_;        // gravitational acceleration, magnitude [m/s^2]
+  Vec3 up_;         // unit vector against gravity
 };
 
 }  // namespace clothlab
