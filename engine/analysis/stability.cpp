@@ -4,6 +4,7 @@
 #include <cmath>
 #include <functional>
 #include <stdexcept>
+#include <string>
 #include <utility>
 #include <vector>
 
@@ -184,6 +185,25 @@ double oscillator_dt_limit(std::string_view integrator, double omega, double bet
   return lo;
 }
 
+std::string round_down(double x, int digits) {
+  if (!(x > 0.0) || !std::isfinite(x)) return fmt::format("{}", x);
+  const int exponent = static_cast<int>(std::floor(std::log10(x))) - (digits - 1);
+  // The leading digits, rounded down; the factor keeps 0.02 from coming out as 199.99999 units
+  // of 1e-4 and printing as 0.0199, and the check below undoes any step it takes too far.
+  double q = std::floor(x / std::pow(10.0, exponent) * (1.0 + 1e-12));
+  for (;;) {
+    const std::string text = fmt::format("{:.{}g}", q * std::pow(10.0, exponent), digits);
+    if (std::stod(text) <= x) return text;
+    q -= 1.0;  // the division or the formatting rounded up: one unit less
+  }
+}
+
+std::string describe_dt_limit(double dt_limit) {
+  if (dt_limit == 0.0) return "none (unstable at every dt)";
+  if (std::isinf(dt_limit)) return "any";
+  return fmt::format("dt <= {} s", round_down(dt_limit));
+}
+
 StiffnessBounds stiffness_bounds(const World& world) {
   const Particles& p = world.particles;
   GershgorinRows rows(p);
@@ -222,9 +242,9 @@ TimeStepAdvice advise_time_step(const World& world, double dt, long steps) {
   std::string why;
   if (advice.dt_limit > 0.0) {
     why = fmt::format(
-        "dt = {} s is above the stability limit of {} for this scene, about {:.3g} s: {} would "
+        "dt = {} s is above the stability limit of {} for this scene, about {} s: {} would "
         "grow by a factor of {} over the run's {} steps",
-        dt, method, advice.dt_limit, mode, growth, steps);
+        dt, method, round_down(advice.dt_limit), mode, growth, steps);
   } else {
     why = fmt::format(
         "{} adds energy at every step on undamped springs: at dt = {} s {} would grow by a "
@@ -232,9 +252,9 @@ TimeStepAdvice advise_time_step(const World& world, double dt, long steps) {
         method, dt, mode, growth, steps);
   }
   advice.warning = fmt::format(
-      "{}. Take dt <= {:.3g} s ({:.0f} times smaller), or method = \"implicit-euler\", which "
+      "{}. Take dt <= {} s ({:.0f} times smaller), or method = \"implicit-euler\", which "
       "is stable at any dt{}",
-      why, suggested, std::ceil(dt / suggested),
+      why, round_down(suggested), std::ceil(dt / suggested),
       advice.dt_limit > 0.0 ? "" : ", or \"symplectic-euler\", which keeps energy bounded");
   return advice;
 }

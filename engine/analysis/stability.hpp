@@ -50,6 +50,14 @@ double spectral_radius(const Eigen::MatrixXd& a);
 // unstable at every dt, infinity when it is stable at every dt.
 double oscillator_dt_limit(std::string_view integrator, double omega, double beta);
 
+// `x` [s] as text with `digits` significant digits, rounded toward zero, so that the number
+// printed is never above x: a printed limit must hold at exactly the value printed.
+std::string round_down(double x, int digits = 3);
+
+// A time-step limit as `clothlab validate` prints it: "dt <= 9.55e-05 s" (rounded down),
+// "none (unstable at every dt)" or "any".
+std::string describe_dt_limit(double dt_limit);
+
 // Gershgorin bounds for a world at its current state.
 struct StiffnessBounds {
   double omega_max = 0.0;  // >= the highest angular frequency [rad/s]

@@ -5,8 +5,11 @@
 // step, so the limits the advisor quotes are the engine's, not a textbook's.
 #include <doctest/doctest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <limits>
 #include <memory>
+#include <random>
 #include <string>
 #include <vector>
 
@@ -300,4 +303,60 @@ duration = 1.0
 )",
                                                       "<guard>");
   CHECK(scene.world.guard.max_energy_growth == 5.0);
+}
+
+namespace {
+
+// The number in `text` after `prefix` (which must be there), as the reader of the text sees it.
+double number_after(const std::string& text, const std::string& prefix) {
+  const auto at = text.find(prefix);
+  REQUIRE_MESSAGE(at != std::string::npos, "no \"" << prefix << "\" in: " << text);
+  return std::stod(text.substr(at + prefix.size()));
+}
+
+}  // namespace
+
+TEST_CASE("advisor: a printed limit never exceeds the true one") {
+  // The issue's case: symplectic Euler at w = 10 rad/s and zeta = 0.5 has the limit
+  // (sqrt(5) - 1) / 10 = 0.1236 s, which rounds to 0.124 s to nearest, above the limit.
+  CHECK(clothlab::describe_dt_limit((std::sqrt(5.0) - 1.0) / 10.0) == "dt <= 0.123 s");
+  CHECK(clothlab::describe_dt_limit(0.0) == "none (unstable at every dt)");
+  CHECK(clothlab::describe_dt_limit(std::numeric_limits<double>::infinity()) == "any");
+  // Rounding down keeps three digits and never goes up, over many magnitudes.
+  std::mt19937 random(8);
+  std::uniform_real_distribution<double> exponent(-9.0, 3.0);
+  for (int i = 0; i < 20000; ++i) {
+    const double x = std::pow(10.0, exponent(random));
+    const double printed = std::stod(clothlab::round_down(x));
+    CAPTURE(x);
+    CHECK(printed <= x);
+    CHECK(printed > x * (1.0 - 1e-2));
+  }
+  // What the advisor prints, over springs from soft to stiff, light to heavy, with and without
+  // dampers: the limit `clothlab validate` prints, the "about" of the warning, and the dt it
+  // suggests are all at most the limit.
+  for (const char* method : {"symplectic-euler", "rk4"}) {
+    for (double k : {1.0, 7.3, 50.0, 640.0, 2.0e4}) {
+      for (double m : {3.4e-4, 0.02, 0.5, 1.7}) {
+        for (double zeta : {0.0, 0.1, 0.5, 2.0}) {
+          CAPTURE(method);
+          CAPTURE(k);
+          CAPTURE(m);
+          CAPTURE(zeta);
+          World world = test::anchored_spring(m, k, 2.0 * zeta * std::sqrt(k * m), 0.01, 0.0);
+          world.integrator = clothlab::make_integrator(method);
+          const double limit =
+              clothlab::advise_time_step(world, 1e-9, 1).dt_limit;  // no warning at this dt
+          REQUIRE(std::isfinite(limit));
+          REQUIRE(limit > 0.0);
+          CHECK(number_after(clothlab::describe_dt_limit(limit), "dt <= ") <= limit);
+          const clothlab::TimeStepAdvice above =
+              clothlab::advise_time_step(world, 2.0 * limit, 500);
+          REQUIRE_FALSE(above.warning.empty());
+          CHECK(number_after(above.warning, ", about ") <= limit);
+          CHECK(number_after(above.warning, "Take dt <= ") <= limit);
+        }
+      }
+    }
+  }
 }
