@@ -13,8 +13,10 @@
 //   implicit Euler               stable at every dt
 // Damping changes the limits, and not always for the better: symplectic Euler needs
 // dt^2 k + 2 dt c < 4 m, position Verlet (whose velocity lags half a step) dt^2 k + 4 dt c < 4 m,
-// explicit Euler dt < c / k up to critical damping. Rather than a formula per case, the advisor
-// computes the eigenvalues of each method's step matrix.
+// while explicit Euler and midpoint, unstable without it, become stable for small enough dt
+// (explicit Euler dt < c / k up to critical damping: exercise ex08.1, stability_limit.hpp).
+// Rather than a formula per case, the advisor computes the eigenvalues of each method's step
+// matrix, and asks the exercise's kernel for explicit Euler.
 //
 // A cloth is many coupled oscillators; its highest angular frequency w_max is the square root
 // of the largest eigenvalue of M^-1 K. Gershgorin's theorem bounds it cheaply, without solving
@@ -46,8 +48,14 @@ Eigen::MatrixXd oscillator_step_matrix(std::string_view integrator, double dt, d
 // The largest |eigenvalue| of a step matrix.
 double spectral_radius(const Eigen::MatrixXd& a);
 
-// The largest dt at which `integrator` is stable on the oscillator (w, beta): 0 when it is
-// unstable at every dt, infinity when it is stable at every dt.
+// The largest dt [s] at which `integrator` is stable on the oscillator (w, beta), found from the
+// eigenvalues of its step matrix: the first dt, going up from 0, at which the spectral radius
+// leaves 1. 0 when it is unstable at every dt, infinity when it is stable at every dt.
+double eigenvalue_dt_limit(std::string_view integrator, double omega, double beta);
+
+// The same limit as the advisor takes it: explicit Euler's from the closed form of exercise
+// ex08.1 (largest_stable_dt_explicit_euler, with m = 1 kg), every other method's from the
+// eigenvalues.
 double oscillator_dt_limit(std::string_view integrator, double omega, double beta);
 
 // `x` [s] as text with `digits` significant digits, rounded toward zero, so that the number

@@ -94,7 +94,7 @@ void limits_table() {
   const std::vector<double> zetas = {0.0, 0.1, 0.5, 1.0, 2.0};
   fmt::print(
       "1. Largest stable y = dt w on x'' = -w^2 x - 2 zeta w x': from the eigenvalues of one\n"
-      "   step's matrix (oscillator_dt_limit), and in brackets the closed form\n");
+      "   step's matrix (eigenvalue_dt_limit), and in brackets the closed form\n");
   fmt::print("   {:>16}", "method");
   for (const double zeta : zetas)
     fmt::print("  {:>17}", fmt::format("zeta = {:g}", zeta));
@@ -103,7 +103,7 @@ void limits_table() {
   for (const std::string_view method : integrator_names()) {
     fmt::print("   {:>16}", method);
     for (const double zeta : zetas) {
-      const double y = oscillator_dt_limit(method, 1.0, 2.0 * zeta);
+      const double y = eigenvalue_dt_limit(method, 1.0, 2.0 * zeta);
       const double formula = closed_form(method, zeta);
       std::string cell = limit_text(y);
       if (!std::isnan(formula)) {
