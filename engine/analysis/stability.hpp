@@ -25,13 +25,18 @@
 //   w_max^2 <= max_i  |K_ii| / m_i  +  sum over springs (i, j) of |K_ij| / sqrt(m_i m_j)
 // where |.| is a block's largest |eigenvalue| and a pinned j adds nothing off the diagonal.
 // The same sum over the damping blocks bounds beta. Both are upper bounds, tight for a single
-// spring and within about 1.5 times for a cloth grid. The advisor feeds them to the oscillator
-// above and reports the time-step limit and how much the stiffest mode would grow.
+// spring and within about 1.5 times for a cloth grid. A particle's two row sums belong together:
+// a mode that stretches its springs also works their dampers, so each particle's row is one
+// oscillator (w_i, beta_i), and the advisor takes the worst of them. (Pairing the highest w
+// with the smallest damping anywhere would call explicit Euler unstable on any cloth whose
+// dampers sit on its springs.) It reports the time-step limit and how much the stiffest mode
+// would grow.
 #pragma once
 
 #include <limits>
 #include <string>
 #include <string_view>
+#include <vector>
 
 #include <Eigen/Core>
 
@@ -66,11 +71,21 @@ std::string round_down(double x, int digits = 3);
 // "none (unstable at every dt)" or "any".
 std::string describe_dt_limit(double dt_limit);
 
+// One particle's Gershgorin row as an oscillator x'' = -w^2 x - beta x'.
+struct RowOscillator {
+  double omega = 0.0;  // the square root of the row's stiffness sum [rad/s]
+  double beta = 0.0;   // the row's damping sum [1/s]
+};
+
 // Gershgorin bounds for a world at its current state.
 struct StiffnessBounds {
   double omega_max = 0.0;  // >= the highest angular frequency [rad/s]
   double beta_max = 0.0;   // >= the largest damping rate c/m of any mode [1/s]
   double beta_min = 0.0;   // <= the damping rate every particle has ([damping] rate) [1/s]
+  // The free particles' rows, those alike merged: for each damping ratio zeta = beta / 2w
+  // (to 0.1 %), the highest w that has it, with the ratio's lowest and highest value in the
+  // group. A method's limit at a fixed zeta falls as 1 / w, so these hold the worst row.
+  std::vector<RowOscillator> rows;
 };
 StiffnessBounds stiffness_bounds(const World& world);
 
