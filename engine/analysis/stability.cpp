@@ -1,14 +1,20 @@
 #include "analysis/stability.hpp"
 
 #include <algorithm>
+#include <climits>
 #include <cmath>
 #include <functional>
+#include <map>
 #include <stdexcept>
+#include <string>
 #include <utility>
 #include <vector>
 
 #include <fmt/format.h>
 #include <Eigen/Eigenvalues>
+
+#include "clothlab/core/not_implemented.hpp"
+#include "clothlab/integrators/stability_limit.hpp"
 
 namespace clothlab {
 
@@ -26,13 +32,43 @@ Matrix matrix_of(int n, const std::function<Vector(const Vector&)>& step) {
   return a;
 }
 
-// The biggest factor by which the stiffest mode's amplitude grows in `steps` steps at dt, for
-// the worse of the two damping bounds.
+// The biggest factor by which a row's oscillator grows in `steps` steps at dt, over the rows.
 double growth_over(std::string_view integrator, double dt, double steps, const StiffnessBounds& b) {
-  const double rho =
-      std::max(spectral_radius(oscillator_step_matrix(integrator, dt, b.omega_max, b.beta_min)),
-               spectral_radius(oscillator_step_matrix(integrator, dt, b.omega_max, b.beta_max)));
+  double rho = 0.0;
+  for (const RowOscillator& row : b.rows) {
+    // In the row's own time (w = 1, y = dt w), where the matrix is well scaled.
+    const Matrix a = oscillator_step_matrix(integrator, dt * row.omega, 1.0, row.beta / row.omega);
+    rho = std::max(rho, spectral_radius(a));
+  }
   return std::pow(rho, steps);
+}
+
+// Merges rows with the same damping ratio zeta = beta / 2w, to 0.1 %, keeping the highest w of
+// each group with the group's lowest and highest zeta. At a fixed zeta every method's limit is
+// y(zeta) / w, so the highest w of a group has its smallest limit; a regular cloth has a handful
+// of groups where it has thousands of particles, and the advisor solves for a limit per group.
+std::vector<RowOscillator> merge_rows(const std::vector<RowOscillator>& rows) {
+  struct Group {
+    double omega = 0.0, zeta_lo = 0.0, zeta_hi = 0.0;
+  };
+  std::map<long long, Group> groups;
+  for (const RowOscillator& row : rows) {
+    if (row.omega == 0.0) continue;  // no spring on this particle: nothing oscillates
+    const double zeta = row.beta / (2.0 * row.omega);
+    const long long key = zeta > 0.0 ? std::llround(std::log(zeta) / std::log1p(1e-3)) : LLONG_MIN;
+    const auto [at, is_new] = groups.try_emplace(key, Group{row.omega, zeta, zeta});
+    Group& g = at->second;
+    if (is_new) continue;
+    g.omega = std::max(g.omega, row.omega);
+    g.zeta_lo = std::min(g.zeta_lo, zeta);
+    g.zeta_hi = std::max(g.zeta_hi, zeta);
+  }
+  std::vector<RowOscillator> merged;
+  for (const auto& [key, g] : groups) {
+    merged.push_back({g.omega, 2.0 * g.zeta_lo * g.omega});
+    if (g.zeta_hi != g.zeta_lo) merged.push_back({g.omega, 2.0 * g.zeta_hi * g.omega});
+  }
+  return merged;
 }
 
 // Collects block Gershgorin row sums of M^-1/2 K M^-1/2 and of the damping blocks: for row i,
@@ -72,11 +108,15 @@ class GershgorinRows final : public ForceJacobians {
     StiffnessBounds b;
     bool any_free = false;
     b.beta_min = kInfinity;
+    std::vector<RowOscillator> rows;
     for (Index i = 0; i < p_.size(); ++i) {
       if (p_.inv_m[i] == 0.0) continue;
       any_free = true;
-      b.omega_max = std::max(b.omega_max, norm(k_diagonal_[i]) * p_.inv_m[i] + k_off_[i]);
-      b.beta_max = std::max(b.beta_max, norm(c_diagonal_[i]) * p_.inv_m[i] + c_off_[i]);
+      const double w2 = norm(k_diagonal_[i]) * p_.inv_m[i] + k_off_[i];
+      const double beta = norm(c_diagonal_[i]) * p_.inv_m[i] + c_off_[i];
+      rows.push_back({std::sqrt(w2), beta});
+      b.omega_max = std::max(b.omega_max, w2);
+      b.beta_max = std::max(b.beta_max, beta);
       // The damping every direction of this particle gets: the smallest eigenvalue of its own
       // damping block ([damping] rate m I gives the rate).
       Eigen::SelfAdjointEigenSolver<Mat3> eigen;
@@ -86,6 +126,7 @@ class GershgorinRows final : public ForceJacobians {
     }
     b.omega_max = std::sqrt(b.omega_max);
     if (!any_free) b.beta_min = 0.0;
+    b.rows = merge_rows(rows);
     return b;
   }
 
@@ -161,27 +202,68 @@ double spectral_radius(const Matrix& a) {
   return a.eigenvalues().cwiseAbs().maxCoeff();
 }
 
-double oscillator_dt_limit(std::string_view integrator, double omega, double beta) {
-  // Stable: no eigenvalue outside the unit circle (beyond rounding).
-  const auto stable = [&](double h) {
-    return spectral_radius(oscillator_step_matrix(integrator, h, omega, beta)) <= 1.0 + 1e-12;
+double eigenvalue_dt_limit(std::string_view integrator, double omega, double beta) {
+  // The search runs in the oscillator's own time, w = 1 and y = dt w, and scales back at the end:
+  // the eigenvalues are the same, and the matrix stays well scaled however stiff the spring (at
+  // w = 1e4 rad/s position Verlet's matrix would hold both dt and w^2 / dt, 1e-6 s and 1e14 1/s^3,
+  // and its eigenvalues would carry errors far above the 1e-12 allowed for rounding).
+  const double b = beta / omega;
+  const auto rho = [&](double y) {
+    return spectral_radius(oscillator_step_matrix(integrator, y, 1.0, b));
   };
-  // At y = 0.01 the growth of explicit Euler (y^2 / 2 a step) and of midpoint (y^4 / 8) still
-  // shows above rounding: a method unstable there is "unstable at every dt" for any practical
-  // purpose, even if some damping would make a yet smaller dt stable.
-  double lo = 1e-2 / omega;
-  if (!stable(lo)) return 0.0;
-  double hi = 1.0 / omega;
+  // Stable: no eigenvalue outside the unit circle (beyond rounding).
+  const auto stable = [&](double y) { return rho(y) <= 1.0 + 1e-12; };
+  // At y = 0.01 the growth of undamped explicit Euler (y^2 / 2 a step) and midpoint (y^4 / 8)
+  // still shows above rounding. A damped method unstable there may be stable further down
+  // (explicit Euler below y = 2 zeta, midpoint below about y = 2 zeta^(1/3)): halve y until a
+  // step visibly loses amplitude (rho below 1 by more than rounding), or call the method
+  // unstable at every dt once y is below 1e-9.
+  double lo = 1e-2;
+  if (!stable(lo)) {
+    do {
+      lo *= 0.5;
+      if (lo < 1e-9) return 0.0;
+    } while (!(rho(lo) < 1.0 - 1e-14));
+  }
+  // Up in steps of 10 % to the first unstable y, then bisect between the last two.
+  double hi = 1.1 * lo;
   while (stable(hi)) {
     lo = hi;
-    hi *= 2.0;
-    if (hi > 1e6 / omega) return kInfinity;
+    hi *= 1.1;
+    if (hi > 1e6) return kInfinity;
   }
   for (int k = 0; k < 60; ++k) {
     const double mid = 0.5 * (lo + hi);
     (stable(mid) ? lo : hi) = mid;
   }
-  return lo;
+  return lo / omega;
+}
+
+double oscillator_dt_limit(std::string_view integrator, double omega, double beta) {
+  // Explicit Euler's limit has a closed form, which lesson 08's exercise derives (m = 1 kg:
+  // k = w^2, c = beta).
+  if (integrator == "explicit-euler")
+    return largest_stable_dt_explicit_euler(omega * omega, 1.0, beta);
+  return eigenvalue_dt_limit(integrator, omega, beta);
+}
+
+std::string round_down(double x, int digits) {
+  if (!(x > 0.0) || !std::isfinite(x)) return fmt::format("{}", x);
+  const int exponent = static_cast<int>(std::floor(std::log10(x))) - (digits - 1);
+  // The leading digits, rounded down; the factor keeps 0.02 from coming out as 199.99999 units
+  // of 1e-4 and printing as 0.0199, and the check below undoes any step it takes too far.
+  double q = std::floor(x / std::pow(10.0, exponent) * (1.0 + 1e-12));
+  for (;;) {
+    const std::string text = fmt::format("{:.{}g}", q * std::pow(10.0, exponent), digits);
+    if (std::stod(text) <= x) return text;
+    q -= 1.0;  // the division or the formatting rounded up: one unit less
+  }
+}
+
+std::string describe_dt_limit(double dt_limit) {
+  if (dt_limit == 0.0) return "none (unstable at every dt)";
+  if (std::isinf(dt_limit)) return "any";
+  return fmt::format("dt <= {} s", round_down(dt_limit));
 }
 
 StiffnessBounds stiffness_bounds(const World& world) {
@@ -198,8 +280,19 @@ TimeStepAdvice advise_time_step(const World& world, double dt, long steps) {
   const StiffnessBounds& b = advice.bounds;
   if (!world.integrator || b.omega_max == 0.0) return advice;  // no springs: nothing to limit
   const std::string method(world.integrator->name());
-  advice.dt_limit = std::min(oscillator_dt_limit(method, b.omega_max, b.beta_min),
-                             oscillator_dt_limit(method, b.omega_max, b.beta_max));
+  // The worst row. Until exercise ex08.1 is done, explicit Euler's limit comes from the
+  // eigenvalues, as every other method's does.
+  const auto worst_row = [&](const auto& limit) {
+    double worst = kInfinity;
+    for (const RowOscillator& row : b.rows)
+      worst = std::min(worst, limit(method, row.omega, row.beta));
+    return worst;
+  };
+  try {
+    advice.dt_limit = worst_row(oscillator_dt_limit);
+  } catch (const NotImplemented&) {
+    advice.dt_limit = worst_row(eigenvalue_dt_limit);
+  }
   advice.growth = growth_over(method, dt, static_cast<double>(steps), b);
   if (advice.growth <= 2.0) return advice;
 
@@ -222,9 +315,9 @@ TimeStepAdvice advise_time_step(const World& world, double dt, long steps) {
   std::string why;
   if (advice.dt_limit > 0.0) {
     why = fmt::format(
-        "dt = {} s is above the stability limit of {} for this scene, about {:.3g} s: {} would "
+        "dt = {} s is above the stability limit of {} for this scene, about {} s: {} would "
         "grow by a factor of {} over the run's {} steps",
-        dt, method, advice.dt_limit, mode, growth, steps);
+        dt, method, round_down(advice.dt_limit), mode, growth, steps);
   } else {
     why = fmt::format(
         "{} adds energy at every step on undamped springs: at dt = {} s {} would grow by a "
@@ -232,9 +325,9 @@ TimeStepAdvice advise_time_step(const World& world, double dt, long steps) {
         method, dt, mode, growth, steps);
   }
   advice.warning = fmt::format(
-      "{}. Take dt <= {:.3g} s ({:.0f} times smaller), or method = \"implicit-euler\", which "
+      "{}. Take dt <= {} s ({:.0f} times smaller), or method = \"implicit-euler\", which "
       "is stable at any dt{}",
-      why, suggested, std::ceil(dt / suggested),
+      why, round_down(suggested), std::ceil(dt / suggested),
       advice.dt_limit > 0.0 ? "" : ", or \"symplectic-euler\", which keeps energy bounded");
   return advice;
 }

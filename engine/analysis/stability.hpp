@@ -13,8 +13,10 @@
 //   implicit Euler               stable at every dt
 // Damping changes the limits, and not always for the better: symplectic Euler needs
 // dt^2 k + 2 dt c < 4 m, position Verlet (whose velocity lags half a step) dt^2 k + 4 dt c < 4 m,
-// explicit Euler dt < c / k up to critical damping. Rather than a formula per case, the advisor
-// computes the eigenvalues of each method's step matrix.
+// while explicit Euler and midpoint, unstable without it, become stable for small enough dt
+// (explicit Euler dt < c / k up to critical damping: exercise ex08.1, stability_limit.hpp).
+// Rather than a formula per case, the advisor computes the eigenvalues of each method's step
+// matrix, and asks the exercise's kernel for explicit Euler.
 //
 // A cloth is many coupled oscillators; its highest angular frequency w_max is the square root
 // of the largest eigenvalue of M^-1 K. Gershgorin's theorem bounds it cheaply, without solving
@@ -23,13 +25,18 @@
 //   w_max^2 <= max_i  |K_ii| / m_i  +  sum over springs (i, j) of |K_ij| / sqrt(m_i m_j)
 // where |.| is a block's largest |eigenvalue| and a pinned j adds nothing off the diagonal.
 // The same sum over the damping blocks bounds beta. Both are upper bounds, tight for a single
-// spring and within about 1.5 times for a cloth grid. The advisor feeds them to the oscillator
-// above and reports the time-step limit and how much the stiffest mode would grow.
+// spring and within about 1.5 times for a cloth grid. A particle's two row sums belong together:
+// a mode that stretches its springs also works their dampers, so each particle's row is one
+// oscillator (w_i, beta_i), and the advisor takes the worst of them. (Pairing the highest w
+// with the smallest damping anywhere would call explicit Euler unstable on any cloth whose
+// dampers sit on its springs.) It reports the time-step limit and how much the stiffest mode
+// would grow.
 #pragma once
 
 #include <limits>
 #include <string>
 #include <string_view>
+#include <vector>
 
 #include <Eigen/Core>
 
@@ -46,15 +53,39 @@ Eigen::MatrixXd oscillator_step_matrix(std::string_view integrator, double dt, d
 // The largest |eigenvalue| of a step matrix.
 double spectral_radius(const Eigen::MatrixXd& a);
 
-// The largest dt at which `integrator` is stable on the oscillator (w, beta): 0 when it is
-// unstable at every dt, infinity when it is stable at every dt.
+// The largest dt [s] at which `integrator` is stable on the oscillator (w, beta), found from the
+// eigenvalues of its step matrix: the first dt, going up from 0, at which the spectral radius
+// leaves 1. 0 when it is unstable at every dt, infinity when it is stable at every dt.
+double eigenvalue_dt_limit(std::string_view integrator, double omega, double beta);
+
+// The same limit as the advisor takes it: explicit Euler's from the closed form of exercise
+// ex08.1 (largest_stable_dt_explicit_euler, with m = 1 kg), every other method's from the
+// eigenvalues.
 double oscillator_dt_limit(std::string_view integrator, double omega, double beta);
+
+// `x` [s] as text with `digits` significant digits, rounded toward zero, so that the number
+// printed is never above x: a printed limit must hold at exactly the value printed.
+std::string round_down(double x, int digits = 3);
+
+// A time-step limit as `clothlab validate` prints it: "dt <= 9.55e-05 s" (rounded down),
+// "none (unstable at every dt)" or "any".
+std::string describe_dt_limit(double dt_limit);
+
+// One particle's Gershgorin row as an oscillator x'' = -w^2 x - beta x'.
+struct RowOscillator {
+  double omega = 0.0;  // the square root of the row's stiffness sum [rad/s]
+  double beta = 0.0;   // the row's damping sum [1/s]
+};
 
 // Gershgorin bounds for a world at its current state.
 struct StiffnessBounds {
   double omega_max = 0.0;  // >= the highest angular frequency [rad/s]
   double beta_max = 0.0;   // >= the largest damping rate c/m of any mode [1/s]
   double beta_min = 0.0;   // <= the damping rate every particle has ([damping] rate) [1/s]
+  // The free particles' rows, those alike merged: for each damping ratio zeta = beta / 2w
+  // (to 0.1 %), the highest w that has it, with the ratio's lowest and highest value in the
+  // group. A method's limit at a fixed zeta falls as 1 / w, so these hold the worst row.
+  std::vector<RowOscillator> rows;
 };
 StiffnessBounds stiffness_bounds(const World& world);
 

@@ -250,9 +250,7 @@ int main(int argc, char** argv) {
       if (advice.bounds.omega_max > 0.0) {
         fmt::print("  stiffest mode: w <= {:.4g} rad/s; stable time step for {}: {}\n",
                    advice.bounds.omega_max, scene.world.integrator->name(),
-                   advice.dt_limit == 0.0        ? std::string("none (unstable at every dt)")
-                   : std::isinf(advice.dt_limit) ? std::string("any")
-                                                 : fmt::format("dt <= {:.3g} s", advice.dt_limit));
+                   describe_dt_limit(advice.dt_limit));
       }
       if (!advice.warning.empty()) {
         std::fflush(stdout);

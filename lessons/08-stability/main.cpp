@@ -45,11 +45,24 @@ namespace {
 
 constexpr double kInfinity = std::numeric_limits<double>::infinity();
 
-// "2.0000", "none" for 0 (unstable at every dt), "any" for infinity.
+// x >= 0 with `decimals` decimals, rounded down: a stable limit printed must hold at exactly the
+// value printed, so 1.23607 is 1.2360, not 1.2361.
+std::string down(double x, int decimals) {
+  const double unit = std::pow(10.0, -decimals);
+  // The factor keeps 0.2 from coming out as 1999.99999 units; the check undoes a step too far.
+  double q = std::floor(x / unit * (1.0 + 1e-12));
+  for (;;) {
+    const std::string text = fmt::format("{:.{}f}", q * unit, decimals);
+    if (std::stod(text) <= x) return text;
+    q -= 1.0;
+  }
+}
+
+// "2.0000", "none" for 0 (unstable at every dt), "any" for infinity; rounded down.
 std::string limit_text(double y) {
   if (y == 0.0) return "none";
   if (std::isinf(y)) return "any";
-  return fmt::format("{:.4f}", y);
+  return down(y, 4);
 }
 
 // --- 1. Limits from the step matrix ------------------------------------------------------------
@@ -81,7 +94,7 @@ void limits_table() {
   const std::vector<double> zetas = {0.0, 0.1, 0.5, 1.0, 2.0};
   fmt::print(
       "1. Largest stable y = dt w on x'' = -w^2 x - 2 zeta w x': from the eigenvalues of one\n"
-      "   step's matrix (oscillator_dt_limit), and in brackets the closed form\n");
+      "   step's matrix (eigenvalue_dt_limit), and in brackets the closed form\n");
   fmt::print("   {:>16}", "method");
   for (const double zeta : zetas)
     fmt::print("  {:>17}", fmt::format("zeta = {:g}", zeta));
@@ -90,7 +103,7 @@ void limits_table() {
   for (const std::string_view method : integrator_names()) {
     fmt::print("   {:>16}", method);
     for (const double zeta : zetas) {
-      const double y = oscillator_dt_limit(method, 1.0, 2.0 * zeta);
+      const double y = eigenvalue_dt_limit(method, 1.0, 2.0 * zeta);
       const double formula = closed_form(method, zeta);
       std::string cell = limit_text(y);
       if (!std::isnan(formula)) {
@@ -210,8 +223,8 @@ void engine_limits() {
       const double mid = std::sqrt(lo * hi);
       (stays_bounded(c.method, c.m0, c.m1, ks, kd, mid) ? lo : hi) = mid;
     }
-    fmt::print("   {:<24}  {:>5g}  {:>9.4f}  {:>10.4f}  {:>10.4f}  {:>7.4f}  {}\n", c.label, c.zeta,
-               w, 1e3 * lo, 1e3 * expected, lo / expected, c.formula_text);
+    fmt::print("   {:<24}  {:>5g}  {:>9.4f}  {:>10}  {:>10}  {:>7.4f}  {}\n", c.label, c.zeta, w,
+               down(1e3 * lo, 4), down(1e3 * expected, 4), lo / expected, c.formula_text);
   }
   fmt::print("\n");
 }
@@ -472,10 +485,11 @@ void stiffest_mode(bool dense) {
     (sheet_bounded(mid) ? lo : hi) = mid;
   }
   fmt::print(
-      "   symplectic Euler's limit [us]: the advisor's {:.2f}; from w_max, {:.2f} with the "
+      "   symplectic Euler's limit [us]: the advisor's {}; from w_max, {} with the "
       "damping\n"
-      "   bound and {:.2f} undamped; measured on the sheet's springs (bisection): {:.2f}\n\n",
-      1e6 * advised, 1e6 * damped, 1e6 * 2.0 / w_true, 1e6 * lo);
+      "   bound and {} undamped; measured on the sheet's springs (bisection): {}\n\n",
+      down(1e6 * advised, 2), down(1e6 * damped, 2), down(1e6 * 2.0 / w_true, 2),
+      down(1e6 * lo, 2));
 }
 
 // --- 6. The stiff sheet, three ways ------------------------------------------------------------

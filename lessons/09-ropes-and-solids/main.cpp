@@ -156,9 +156,9 @@ void hanging_cloth() {
   fmt::print(
       "   * taut-cloth.toml. Built 1 m tall: a cloth that gives 10 % at most hangs about 1.1 m.\n"
       "   Springs stiff enough on their own ({:.1f} times the soft ones, so that the same load\n"
-      "   stretches them 10 % instead of {:.0f} %) are stable only below dt = {:.3f} ms (lesson\n"
+      "   stretches them 10 % instead of {:.0f} %) are stable only below dt = {} ms (lesson\n"
       "   08's advisor); they ran at 0.9 times that.\n\n",
-      factor, 100.0 * soft.strain, 1e3 * dt_stiff);
+      factor, 100.0 * soft.strain, round_down(1e3 * dt_stiff, 4));
 }
 
 void swinging_rope() {

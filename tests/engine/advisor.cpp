@@ -5,8 +5,11 @@
 // step, so the limits the advisor quotes are the engine's, not a textbook's.
 #include <doctest/doctest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <limits>
 #include <memory>
+#include <random>
 #include <string>
 #include <vector>
 
@@ -125,6 +128,14 @@ TEST_CASE("advisor: Gershgorin's bound is exact for one spring and a free pair")
   CHECK(b.omega_max == doctest::Approx(std::sqrt(2.0 * 50.0 / 2.0)));
   CHECK(b.beta_max == doctest::Approx(2.0 * 3.0 / 2.0));
   CHECK(b.beta_min == 0.0);  // no [damping]: some motion (the pair's drift) is undamped
+  // Both rows are the same oscillator, the spring's own, with its damper: merged into one
+  // group (two entries at most, if rounding set their ratios a hair apart).
+  REQUIRE(!b.rows.empty());
+  REQUIRE(b.rows.size() <= 2);
+  for (const clothlab::RowOscillator& row : b.rows) {
+    CHECK(row.omega == doctest::Approx(std::sqrt(2.0 * 50.0 / 2.0)));
+    CHECK(row.beta == doctest::Approx(2.0 * 3.0 / 2.0));
+  }
 }
 
 TEST_CASE("advisor: on a cloth the bound lies above the true highest frequency, within 2x") {
@@ -300,4 +311,202 @@ duration = 1.0
 )",
                                                       "<guard>");
   CHECK(scene.world.guard.max_energy_growth == 5.0);
+}
+
+namespace {
+
+// The number in `text` after `prefix` (which must be there), as the reader of the text sees it.
+double number_after(const std::string& text, const std::string& prefix) {
+  const auto at = text.find(prefix);
+  REQUIRE_MESSAGE(at != std::string::npos, "no \"" << prefix << "\" in: " << text);
+  return std::stod(text.substr(at + prefix.size()));
+}
+
+// The largest stable dt [s] of `method` on (w, beta) found here, apart from the advisor: the
+// spectral radius of the step matrix (checked against the engine's steps above) scanned up from
+// y = 1e-3 in steps of 1 %, then bisected. Infinity above y = 1e3.
+double scanned_limit(const std::string& method, double omega, double beta) {
+  const auto stable = [&](double y) {
+    return clothlab::spectral_radius(
+               clothlab::oscillator_step_matrix(method, y / omega, omega, beta)) <= 1.0 + 1e-12;
+  };
+  double y = 1e-3;
+  REQUIRE(stable(y));
+  while (y < 1e3 && stable(1.01 * y))
+    y *= 1.01;
+  if (y >= 1e3) return std::numeric_limits<double>::infinity();
+  double lo = y, hi = 1.01 * y;
+  for (int k = 0; k < 60; ++k) {
+    const double mid = 0.5 * (lo + hi);
+    (stable(mid) ? lo : hi) = mid;
+  }
+  return lo / omega;
+}
+
+double energy(const World& world) {
+  return world.kinetic_energy() + world.potential_energy();
+}
+
+}  // namespace
+
+TEST_CASE("advisor: a printed limit never exceeds the true one") {
+  // The issue's case: symplectic Euler at w = 10 rad/s and zeta = 0.5 has the limit
+  // (sqrt(5) - 1) / 10 = 0.1236 s, which rounds to 0.124 s to nearest, above the limit.
+  CHECK(clothlab::describe_dt_limit((std::sqrt(5.0) - 1.0) / 10.0) == "dt <= 0.123 s");
+  CHECK(clothlab::describe_dt_limit(0.0) == "none (unstable at every dt)");
+  CHECK(clothlab::describe_dt_limit(std::numeric_limits<double>::infinity()) == "any");
+  // Rounding down keeps three digits and never goes up, over many magnitudes.
+  std::mt19937 random(8);
+  std::uniform_real_distribution<double> exponent(-9.0, 3.0);
+  for (int i = 0; i < 20000; ++i) {
+    const double x = std::pow(10.0, exponent(random));
+    const double printed = std::stod(clothlab::round_down(x));
+    CAPTURE(x);
+    CHECK(printed <= x);
+    CHECK(printed > x * (1.0 - 1e-2));
+  }
+  // What the advisor prints, over springs from soft to stiff, light to heavy, with and without
+  // dampers: the limit `clothlab validate` prints, the "about" of the warning, and the dt it
+  // suggests are all at most the limit.
+  for (const char* method : {"symplectic-euler", "explicit-euler", "rk4", "position-verlet"}) {
+    for (double k : {1.0, 7.3, 50.0, 640.0, 2.0e4}) {
+      for (double m : {3.4e-4, 0.02, 0.5, 1.7}) {
+        for (double zeta : {0.0, 0.1, 0.5, 2.0}) {
+          if (zeta == 0.0 && std::string(method) == "explicit-euler") continue;
+          CAPTURE(method);
+          CAPTURE(k);
+          CAPTURE(m);
+          CAPTURE(zeta);
+          World world = test::anchored_spring(m, k, 2.0 * zeta * std::sqrt(k * m), 0.01, 0.0);
+          world.integrator = clothlab::make_integrator(method);
+          const double limit =
+              clothlab::advise_time_step(world, 1e-9, 1).dt_limit;  // no warning at this dt
+          REQUIRE(std::isfinite(limit));
+          REQUIRE(limit > 0.0);
+          CHECK(number_after(clothlab::describe_dt_limit(limit), "dt <= ") <= limit);
+          const clothlab::TimeStepAdvice above =
+              clothlab::advise_time_step(world, 2.0 * limit, 500);
+          REQUIRE_FALSE(above.warning.empty());
+          CHECK(number_after(above.warning, ", about ") <= limit);
+          CHECK(number_after(above.warning, "Take dt <= ") <= limit);
+        }
+      }
+    }
+  }
+}
+
+TEST_CASE("advisor: with dampers every method gets its damped limit, and the engine agrees") {
+  // One particle on a spring-damper, for several (w, zeta). The advisor's limit must be the
+  // closed form where there is one (stability.cpp derives them) and the scan of the step
+  // matrix's spectral radius above everywhere; then the engine's own run of the spring decays
+  // at 0.99 of the limit and grows at 1.01 of it.
+  const double m = 0.5;
+  for (const std::string& method : test::all_integrators()) {
+    for (double omega : {3.0, 40.0}) {
+      for (double zeta : {0.05, 0.3, 0.7, 1.5}) {
+        CAPTURE(method);
+        CAPTURE(omega);
+        CAPTURE(zeta);
+        const double k = omega * omega * m, c = 2.0 * zeta * omega * m;
+        World probe = test::anchored_spring(m, k, c, 1e-4, 0.0);
+        probe.integrator = clothlab::make_integrator(method);
+        const clothlab::TimeStepAdvice advice = clothlab::advise_time_step(probe, 1e-6, 1);
+        const double limit = advice.dt_limit;
+        CHECK(advice.warning.empty());
+        if (method == "implicit-euler") {
+          CHECK(std::isinf(limit));
+          continue;
+        }
+        REQUIRE(std::isfinite(limit));
+        CHECK(limit ==
+              doctest::Approx(scanned_limit(method, omega, 2.0 * zeta * omega)).epsilon(1e-9));
+        double y = std::nan("");  // the closed form of y = dt w, where there is one
+        if (method == "explicit-euler")
+          y = zeta < 1.0 ? 2.0 * zeta : 2.0 / (zeta + std::sqrt(zeta * zeta - 1.0));
+        if (method == "symplectic-euler") y = std::sqrt(4.0 * zeta * zeta + 4.0) - 2.0 * zeta;
+        if (method == "position-verlet") y = std::sqrt(16.0 * zeta * zeta + 4.0) - 4.0 * zeta;
+        if (method == "velocity-verlet")
+          y = zeta < 0.5
+                  ? 2.0 * (std::sqrt(1.0 - 3.0 * zeta * zeta) - zeta) / (1.0 - 4.0 * zeta * zeta)
+                  : 1.0 / zeta;
+        if (!std::isnan(y)) CHECK(limit * omega == doctest::Approx(y).epsilon(1e-9));
+
+        // N steps, enough for the growing mode's amplitude to grow 10 times at 1.01 of the
+        // limit. Three times N: the start may hold little of the growing mode, but after N steps
+        // it leads, and the highest energy of steps 2N to 3N is about 100 times that of steps N
+        // to 2N (30 is asked: the energy swings within a period). The steps call the
+        // integrator directly: the guard would stop a growing run, which is the point here.
+        const double rho = clothlab::spectral_radius(
+            clothlab::oscillator_step_matrix(method, 1.01 * limit, omega, c / m));
+        REQUIRE(rho > 1.0);
+        const int steps = static_cast<int>(std::ceil(std::log(10.0) / std::log(rho)));
+        REQUIRE(steps < 1000000);
+        for (const double fraction : {0.99, 1.01}) {
+          CAPTURE(fraction);
+          World world = test::anchored_spring(m, k, c, 1e-4, 0.7e-4 * omega);
+          world.integrator = clothlab::make_integrator(method);
+          const double e0 = energy(world);
+          double second = 0.0, third = 0.0;  // the highest energy of steps N to 2N, 2N to 3N
+          for (int s = 1; s <= 3 * steps; ++s) {
+            world.integrator->advance(world, fraction * limit);
+            if (s > steps) {
+              double& peak = s <= 2 * steps ? second : third;
+              peak = std::max(peak, energy(world));
+            }
+          }
+          if (fraction < 1.0)
+            CHECK(energy(world) < e0);
+          else
+            CHECK(third > 30.0 * second);
+        }
+      }
+    }
+  }
+}
+
+TEST_CASE("advisor: explicit Euler on a cloth with dampers is stable up to kd / ks") {
+  // A cloth whose every spring has the same kd / ks: each particle's damping row is kd / ks
+  // times its stiffness row, so every row's oscillator has beta = (kd / ks) w^2, and explicit
+  // Euler's underdamped limit beta / w^2 = kd / ks is the same for every row (and for every
+  // mode of the true cloth). The advisor must say so, not "unstable at every dt", and the cloth
+  // must settle below it and blow up above it.
+  const std::string text = R"(
+[cloth]
+rows = 6
+cols = 5
+spacing = 0.1
+mass = 0.3
+pins = "top-corners"
+[springs]
+ks = 200.0
+kd = 0.4
+[integrator]
+method = "explicit-euler"
+dt = 0.001
+duration = 10.0
+)";
+  const double ratio = 0.4 / 200.0;  // kd / ks = 2 ms
+  const clothlab::Scene scene = clothlab::parse_scene(text, "<damped cloth>");
+  const clothlab::TimeStepAdvice advice =
+      clothlab::advise_time_step(scene.world, scene.dt, scene.step_count());
+  CHECK(advice.dt_limit == doctest::Approx(ratio).epsilon(1e-9));
+  CHECK(advice.warning.empty());
+  // Each free particle nudged by up to 1 mm, so that every mode starts with some energy.
+  for (const double fraction : {0.95, 1.05}) {
+    CAPTURE(fraction);
+    clothlab::Scene run = clothlab::parse_scene(text, "<damped cloth>");
+    World& world = run.world;
+    std::mt19937 random(3);
+    std::uniform_real_distribution<double> nudge(-1e-3, 1e-3);
+    for (Index i = 0; i < world.particles.size(); ++i)
+      if (world.particles.inv_m[i] != 0.0)
+        world.particles.x.col(i) += Vec3(nudge(random), nudge(random), nudge(random));
+    const double e0 = energy(world);
+    for (int s = 0; s < 5000; ++s)
+      world.integrator->advance(world, fraction * ratio);
+    if (fraction < 1.0)
+      CHECK(energy(world) < 1e-3 * e0);
+    else
+      CHECK(!(energy(world) < 1e3 * e0));  // grown a thousand times, or no longer finite
+  }
 }

@@ -6,6 +6,7 @@
 
 #include <string>
 
+#include "analysis/stability.hpp"
 #include "clothlab/after_step/self_collision.hpp"
 #include "clothlab/core/not_implemented.hpp"
 #include "scene/scene.hpp"
@@ -53,4 +54,36 @@ duration = 1
   // pair_response.
   w.particles.x(1, 1) = 0.01;
   CHECK(stops_at([&] { effect->respond(w.particles, {{0, 1}}); }) == "ex10.2");
+}
+
+TEST_CASE("student build: the advisor's explicit Euler limit is the student's kernel (ex08.1)") {
+  // A unit mass on a spring (w = 10 rad/s) with a damper (beta = 2 1/s): the limit is asked of
+  // largest_stable_dt_explicit_euler, which the stubs have not written yet.
+  CHECK(stops_at([] { clothlab::oscillator_dt_limit("explicit-euler", 10.0, 2.0); }) == "ex08.1");
+  // The advisor itself keeps working on a stub (a student at lesson 02 runs explicit Euler on
+  // springs long before lesson 08): it takes the limit from the eigenvalues, c / k = 0.02 s.
+  clothlab::Scene scene = clothlab::parse_scene(R"(
+[[particle]]
+position = [0.0, 0.0, 0.0]
+mass = 1.0
+pinned = true
+[[particle]]
+position = [1.0, 0.0, 0.0]
+mass = 1.0
+[[spring]]
+i = 0
+j = 1
+ks = 100.0
+kd = 2.0
+[integrator]
+method = "explicit-euler"
+dt = 0.001
+duration = 1
+)",
+                                                "stubs.toml");
+  double limit = 0.0;
+  CHECK(stops_at([&] {
+          limit = clothlab::advise_time_step(scene.world, scene.dt, scene.step_count()).dt_limit;
+        }) == "");
+  CHECK(limit == doctest::Approx(0.02).epsilon(1e-9));
 }

@@ -326,6 +326,10 @@ void rk4_step(Matrix3X& x, Matrix3X& v, double dt, const AccelerationField& acce
   call(CLOTHLAB_KERNEL(rk4_step), x, v, dt, accel, stages);
 }
 
+double largest_stable_dt_explicit_euler(double k, double m, double c) {
+  return call(CLOTHLAB_KERNEL(largest_stable_dt_explicit_euler), k, m, c);
+}
+
 StrainCorrection strain_limit_correction(const Vec3& r1, const Vec3& r2, double w1, double w2,
                                          double l0, const StrainLimits& limits) {
   return call(CLOTHLAB_KERNEL(strain_limit_correction), r1, r2, w1, w2, l0, limits);

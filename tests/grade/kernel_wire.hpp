@@ -59,31 +59,33 @@
 #include "clothlab/forces/spring_damper.hpp"
 #include "clothlab/integrators/euler.hpp"
 #include "clothlab/integrators/runge_kutta.hpp"
+#include "clothlab/integrators/stability_limit.hpp"
 
 namespace clothlab::wire {
 
 // Every kernel a student writes: the functions between BEGIN and END in exercises/. The grading
 // binary defines each one as a call to the kernels' process; a kernel missing here leaves the
 // grading binary with an undefined symbol, so the list cannot fall behind the engine's headers.
-#define CLOTHLAB_EXERCISE_KERNELS(X) \
-  X(gravity_force)                   \
-  X(gravitation_force)               \
-  X(explicit_euler_step)             \
-  X(symplectic_euler_step)           \
-  X(spring_damper_force)             \
-  X(spring_energy)                   \
-  X(aerodynamic_force)               \
-  X(fluid_drag_force)                \
-  X(bending_pairs)                   \
-  X(collision_response)              \
-  X(plastic_rest_length)             \
-  X(select_tears)                    \
-  X(midpoint_step)                   \
-  X(rk4_step)                        \
-  X(strain_limit_correction)         \
-  X(cell_of)                         \
-  X(cell_hash)                       \
-  X(pair_response)                   \
+#define CLOTHLAB_EXERCISE_KERNELS(X)  \
+  X(gravity_force)                    \
+  X(gravitation_force)                \
+  X(explicit_euler_step)              \
+  X(symplectic_euler_step)            \
+  X(spring_damper_force)              \
+  X(spring_energy)                    \
+  X(aerodynamic_force)                \
+  X(fluid_drag_force)                 \
+  X(bending_pairs)                    \
+  X(collision_response)               \
+  X(plastic_rest_length)              \
+  X(select_tears)                     \
+  X(midpoint_step)                    \
+  X(rk4_step)                         \
+  X(largest_stable_dt_explicit_euler) \
+  X(strain_limit_correction)          \
+  X(cell_of)                          \
+  X(cell_hash)                        \
+  X(pair_response)                    \
   X(accumulate)
 
 #define CLOTHLAB_KERNEL_ENUM(name) name,
