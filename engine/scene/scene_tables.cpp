@@ -78,6 +78,28 @@ void read_particle(SceneTable& t, Scene& scene) {
   if (pinned) pin(scene.world.particles, i);
 }
 
+// `velocity` [m/s] and `spin` [rad/s] of a body, particles [first, first + count): they start
+// moving as one rigid body, v = velocity + spin x (r - c) about their centre of mass c (lesson
+// 09). Called before the pins, which then stop the particles they hold.
+void read_body_motion(SceneTable& t, Scene& scene, Index first, Index count,
+                      std::string_view what) {
+  const Vec3 v0 = t.vec3("velocity", "m/s", Vec3::Zero());
+  const Vec3 w = t.vec3("spin", "rad/s", Vec3::Zero());
+  if (v0 == Vec3::Zero() && w == Vec3::Zero()) return;
+  Particles& p = scene.world.particles;
+  start_moving(p, first, count, v0, w);
+  const double max_speed = scene.world.guard.max_speed;
+  for (Index i = first; i < first + count; ++i) {
+    const Vec3 v = p.v.col(i);
+    if ((v.array().abs() <= max_speed).all()) continue;
+    t.fail(t.has("spin") ? "spin" : "velocity",
+           fmt::format("{} particle {} starts at velocity ({}, {}, {}) m/s, beyond the guard's "
+                       "max_speed = {} m/s; expected each component within {} m/s (a larger "
+                       "max_speed in [guard] allows more)",
+                       what, i - first, v.x(), v.y(), v.z(), max_speed, max_speed));
+  }
+}
+
 // Pins of a builder: a name (e.g. "top-corners") or an array of local indices below `count`.
 std::vector<Index> read_pins(
     SceneTable& t, Index count,
@@ -147,6 +169,7 @@ void read_rope(SceneTable& t, Scene& scene) {
   // The rope lies between its two ends.
   check_within_guard(t, "start", scene, rope.first, "the rope's first particle");
   check_within_guard(t, "end", scene, rope.first + rope.count - 1, "the rope's last particle");
+  read_body_motion(t, scene, rope.first, rope.count, "the rope's");
   const auto named = [&](std::string_view name, std::vector<Index>& out) {
     if (name == "first" || name == "both") out.push_back(0);
     if (name == "last" || name == "both") out.push_back(rope.count - 1);
@@ -183,6 +206,7 @@ void read_cloth(SceneTable& t, Scene& scene) {
   check_within_guard(t, "origin", scene, grid.first, "the cloth's first particle");
   check_within_guard(t, "spacing", scene, grid.first + grid.size() - 1,
                      "the cloth's last particle");
+  read_body_motion(t, scene, grid.first, grid.size(), "the cloth's");
   const auto named = [&](std::string_view name, std::vector<Index>& out) {
     return named_pins(grid, name, out);
   };
@@ -233,6 +257,7 @@ void read_solid(SceneTable& t, Scene& scene) {
   check_within_guard(t, "corner", scene, lattice.first, "the solid's first particle");
   check_within_guard(t, "size", scene, lattice.first + lattice.size() - 1,
                      "the solid's last particle");
+  read_body_motion(t, scene, lattice.first, lattice.size(), "the solid's");
   const auto named = [&](std::string_view name, std::vector<Index>& out) {
     return named_solid_pins(lattice, name, out);
   };
@@ -560,11 +585,12 @@ constexpr std::array kKinds = {
                    "[guard] with max_position and max_speed", read_guard},
     SceneTableKind{"particle", true, false, "position velocity mass pinned",
                    "[[particle]] with position, velocity and mass", read_particle},
-    SceneTableKind{"rope", false, false, "start end particles mass pins",
+    SceneTableKind{"rope", false, false, "start end particles mass pins velocity spin",
                    "[rope] with start, end, particles and mass", read_rope},
-    SceneTableKind{"cloth", false, false, "rows cols spacing origin plane mass density pins",
+    SceneTableKind{"cloth", false, false,
+                   "rows cols spacing origin plane mass density pins velocity spin",
                    "[cloth] with rows, cols, spacing and mass", read_cloth},
-    SceneTableKind{"solid", false, false, "particles size corner mass pins",
+    SceneTableKind{"solid", false, false, "particles size corner mass pins velocity spin",
                    "[solid] with particles, size and mass", read_solid},
     SceneTableKind{"spring", true, false, "i j ks kd l0", "[[spring]] with i, j and ks",
                    read_spring},

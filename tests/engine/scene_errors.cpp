@@ -356,13 +356,21 @@ TEST_CASE("scene error: a misspelt key in [self_collision]") {
   check_bad_scene("self_collision_unknown_key.toml");
 }
 
+// Bodies that start moving, pins that move, wind that changes, masses by area, what a run writes.
+TEST_CASE("scene error: a solid's velocity of two numbers") {
+  check_bad_scene("solid_velocity_two_numbers.toml");
+}
+TEST_CASE("scene error: a spin that starts the cloth's rim beyond the guard's max_speed") {
+  check_bad_scene("cloth_spin_beyond_guard.toml");
+}
+
 TEST_CASE("scene error: every bad scene file has a test case") {
   // A file added to tests/scenes/bad/ without a test above would never be checked.
   int files = 0;
   for (const auto& entry : fs::directory_iterator(fs::path(CLOTHLAB_TEST_SCENES) / "bad")) {
     if (entry.path().extension() == ".toml") ++files;
   }
-  CHECK(files == 97);
+  CHECK(files == 99);
 }
 
 TEST_CASE("scene error: a missing file") {

@@ -1,0 +1,132 @@
+// What a scene can set moving: bodies that start with a velocity and a spin, pins that follow a
+// path, wind that changes in time, and cloth masses by area. Each against its closed form.
+#include <doctest/doctest.h>
+
+#include <cmath>
+#include <numbers>
+#include <string>
+
+#include "clothlab/forces/aerodynamics.hpp"
+#include "scene/scene.hpp"
+#include "test_util.hpp"
+
+using clothlab::Index;
+using clothlab::Vec3;
+
+namespace {
+
+constexpr double kPi = std::numbers::pi;
+
+// The centre of mass of particles [first, first + count) [m].
+Vec3 centre_of_mass(const clothlab::Particles& p, Index first, Index count) {
+  Vec3 c = Vec3::Zero();
+  double m = 0.0;
+  for (Index i = first; i < first + count; ++i) {
+    c += p.m[i] * p.x.col(i);
+    m += p.m[i];
+  }
+  return c / m;
+}
+
+// Angular momentum about the centre of mass, L = sum m (r - c) x v [kg m^2/s].
+Vec3 angular_momentum(const clothlab::Particles& p) {
+  const Vec3 c = centre_of_mass(p, 0, p.size());
+  Vec3 l = Vec3::Zero();
+  for (Index i = 0; i < p.size(); ++i)
+    l += p.m[i] * Vec3(p.x.col(i) - c).cross(Vec3(p.v.col(i)));
+  return l;
+}
+
+// A free 3 x 4 x 5 lattice, 2 kg, 0.2 x 0.3 x 0.4 m, set moving and spinning; springs, nothing
+// else acts on it.
+const char* kSpinningSolid = R"(
+[solid]
+particles = [3, 4, 5]
+size = [0.2, 0.3, 0.4]
+corner = [1, 2, 3]
+mass = 2
+velocity = [1, -2, 0.5]
+spin = [0.3, -0.7, 2]
+[springs]
+ks = 200
+kd = 0.1
+[integrator]
+dt = 0.001
+duration = 1
+)";
+
+// The mean square offset from the middle of n points evenly spread over a length a:
+// offsets a (k / (n - 1) - 1/2), k = 0..n-1, give a^2 (n + 1) / (12 (n - 1)).
+double mean_square_offset(double a, double n) {
+  return a * a * (n + 1.0) / (12.0 * (n - 1.0));
+}
+
+}  // namespace
+
+TEST_CASE("scene keys: a solid's velocity and spin give the closed-form momenta at t = 0") {
+  const clothlab::Scene scene = clothlab::parse_scene(kSpinningSolid, "spin.toml");
+  const clothlab::World& w = scene.world;
+  const double mass = 2.0;
+  // p = M v0: the spin adds sum m w x (r - c) = w x sum m (r - c) = 0.
+  CHECK((w.momentum() - mass * Vec3(1, -2, 0.5)).norm() < 1e-12);
+  // L = I w. The lattice is symmetric about its centre, so the inertia tensor is diagonal:
+  // I_xx = M (<dy^2> + <dz^2>) and so on, with <d^2> the mean square offset along each axis.
+  const double sx = mean_square_offset(0.2, 3), sy = mean_square_offset(0.3, 4),
+               sz = mean_square_offset(0.4, 5);
+  const Vec3 l_expected(mass * (sy + sz) * 0.3, mass * (sx + sz) * -0.7, mass * (sx + sy) * 2.0);
+  CHECK((angular_momentum(w.particles) - l_expected).norm() < 1e-12);
+  // Every particle: v = v0 + w x (r - c).
+  const Vec3 c = centre_of_mass(w.particles, 0, w.particles.size());
+  CHECK((c - Vec3(1.1, 2.15, 3.2)).norm() < 1e-12);
+  for (Index i = 0; i < w.particles.size(); ++i) {
+    const Vec3 v = Vec3(1, -2, 0.5) + Vec3(0.3, -0.7, 2).cross(Vec3(w.particles.x.col(i) - c));
+    CHECK((Vec3(w.particles.v.col(i)) - v).norm() < 1e-12);
+  }
+}
+
+TEST_CASE("scene keys: a free spinning solid keeps its momentum and angular momentum") {
+  clothlab::Scene scene = clothlab::parse_scene(kSpinningSolid, "spin.toml");
+  const Vec3 p0 = scene.world.momentum();
+  const Vec3 l0 = angular_momentum(scene.world.particles);
+  const Vec3 c0 = centre_of_mass(scene.world.particles, 0, scene.world.particles.size());
+  test::run_to_end(scene);
+  // Springs are equal and opposite along the line between their ends: no net force or torque.
+  CHECK((scene.world.momentum() - p0).norm() < 1e-11);
+  CHECK((angular_momentum(scene.world.particles) - l0).norm() < 1e-11);
+  // The centre of mass went on at v0 for 1 s, and the solid turned: it was not at rest.
+  const Vec3 c1 = centre_of_mass(scene.world.particles, 0, scene.world.particles.size());
+  CHECK((c1 - c0 - Vec3(1, -2, 0.5) * scene.world.t).norm() < 1e-9);
+  CHECK(scene.world.kinetic_energy() > 0.5 * 2.0 * p0.squaredNorm() / 4.0);
+}
+
+TEST_CASE("scene keys: a cloth and a rope start at their velocity and their pins at rest") {
+  const clothlab::Scene scene = clothlab::parse_scene(R"(
+[cloth]
+rows = 3
+cols = 4
+spacing = 0.1
+mass = 1.2
+velocity = [0, 0, 2]
+pins = "top-corners"
+[rope]
+start = [0, 1, 0]
+end = [1, 1, 0]
+particles = 5
+mass = 0.5
+velocity = [1, 0, 0]
+spin = [0, 0, 1]
+[integrator]
+dt = 0.01
+duration = 1
+)",
+                                                      "moving.toml");
+  const clothlab::Particles& p = scene.world.particles;
+  // Cloth: 12 particles of 0.1 kg, 2 of them pinned at rest: p_z = 10 * 0.1 kg * 2 m/s.
+  // Rope: 5 particles of 0.1 kg, centre at x = 0.5: v = (1, 0, 0) + z x (r - c), p = 0.5 kg v0.
+  CHECK((scene.world.momentum() - Vec3(0.5, 0.0, 2.0)).norm() < 1e-12);
+  CHECK(p.v.col(scene.cloth->at(0, 0)).norm() == 0.0);
+  CHECK(p.v.col(scene.cloth->at(0, 3)).norm() == 0.0);
+  CHECK((Vec3(p.v.col(scene.cloth->at(2, 3))) - Vec3(0, 0, 2)).norm() == 0.0);
+  const Index last = scene.rope->first + 4;
+  CHECK((Vec3(p.v.col(last)) - Vec3(1.0, 0.5, 0.0)).norm() < 1e-12);  // (1,0,0) + z x (0.5,0,0)
+}
