@@ -13,6 +13,7 @@
 #include <string>
 #include <string_view>
 
+#include "clothlab/after_step/moving_pins.hpp"
 #include "clothlab/bodies/cloth.hpp"
 #include "clothlab/bodies/rope.hpp"
 #include "clothlab/bodies/solid.hpp"
@@ -52,7 +53,8 @@ struct Scene {
   std::optional<ClothGrid> cloth;
   std::optional<Rope> rope;
   std::optional<SolidLattice> solid;
-  SpringSet springs;  // structural, shear and one-by-one springs: the "springs" effect
+  SpringSet springs;               // structural, shear and one-by-one springs: the "springs" effect
+  std::vector<PinPath> pin_paths;  // the bodies' moving pins: the "moving_pins" effect
 
   long step_count() const;  // steps needed to cover `duration`
 };

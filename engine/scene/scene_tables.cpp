@@ -1,5 +1,6 @@
 #include "scene/scene_tables.hpp"
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <limits>
@@ -8,6 +9,7 @@
 #include <fmt/format.h>
 
 #include "clothlab/after_step/ground_collision.hpp"
+#include "clothlab/after_step/moving_pins.hpp"
 #include "clothlab/after_step/plasticity.hpp"
 #include "clothlab/after_step/self_collision.hpp"
 #include "clothlab/after_step/strain_limiting.hpp"
@@ -126,6 +128,104 @@ std::vector<Index> read_pins(
   return pins;
 }
 
+// Keyframes from `times_key` (increasing times [s]) and `values_key` (one [x, y, z] [unit] a
+// time), both given or neither (then none).
+Keyframes read_keyframes(SceneTable& t, std::string_view times_key, std::string_view values_key,
+                         std::string_view unit) {
+  Keyframes frames;
+  if (!t.has(times_key) && !t.has(values_key)) return frames;
+  if (!t.has(times_key)) {
+    t.fail(values_key, fmt::format("{} has '{}' but no '{}'; expected {} = [t0, t1, ...] [s], one "
+                                   "time for each of its values",
+                                   t.display_name(), values_key, times_key, times_key));
+  }
+  if (!t.has(values_key)) {
+    t.fail(times_key, fmt::format("{} has '{}' but no '{}'; expected {} = [[x, y, z], ...] [{}], "
+                                  "one for each time",
+                                  t.display_name(), times_key, values_key, values_key, unit));
+  }
+  frames.t = t.number_list(times_key, Range::non_negative("s"), "time");
+  frames.y = t.vec3_list(values_key, unit);
+  if (frames.t.empty()) {
+    t.fail(times_key, fmt::format("'{}' in {} is empty; expected at least one time [s]", times_key,
+                                  t.display_name()));
+  }
+  for (size_t k = 1; k < frames.t.size(); ++k) {
+    if (frames.t[k] > frames.t[k - 1]) continue;
+    t.fail(times_key, fmt::format("'{}[{}]' in {} is {} s, not after '{}[{}]' = {} s; expected "
+                                  "increasing times",
+                                  times_key, k, t.display_name(), frames.t[k], times_key, k - 1,
+                                  frames.t[k - 1]));
+  }
+  if (frames.y.size() != frames.t.size()) {
+    t.fail(values_key, fmt::format("{} has {} {} for {} times; expected one for each time",
+                                   t.display_name(), frames.y.size(), values_key, frames.t.size()));
+  }
+  return frames;
+}
+
+// A body's [[NAME.pin_path]] tables: pins that follow keyframed offsets or turn on a circle
+// (moving_pins.hpp). The particles they name are pinned; they are put on their paths once the
+// whole scene is read, so that the springs' rest lengths are those of the body as built.
+void read_pin_paths(SceneTable& body, Scene& scene, Index first, Index count,
+                    const std::function<bool(std::string_view, std::vector<Index>&)>& named,
+                    std::string_view names) {
+  Particles& p = scene.world.particles;
+  for (SceneTable& t : body.tables("pin_path")) {
+    t.check_keys("pins times offsets centre axis period");
+    if (!t.has("pins")) {
+      t.fail("pins", fmt::format("{} has no 'pins'; expected pins = a pin set ({}) or an array of "
+                                 "particle indices",
+                                 t.display_name(), names));
+    }
+    PinPath path;
+    for (Index i : read_pins(t, count, named, names)) {
+      for (const PinPath& other : scene.pin_paths) {
+        if (std::find(other.particles.begin(), other.particles.end(), first + i) ==
+            other.particles.end()) {
+          continue;
+        }
+        t.fail("pins", fmt::format("particle {} of {} is on an earlier path already; expected "
+                                   "each particle on one path at most",
+                                   i, t.display_name()));
+      }
+      pin(p, first + i);
+      path.particles.push_back(first + i);
+      path.x0.push_back(p.x.col(first + i));
+    }
+    if (path.particles.empty()) {
+      t.fail("pins", fmt::format("{} moves no particle; expected at least one in 'pins'",
+                                 t.display_name()));
+    }
+    const bool circle = t.has("centre") || t.has("axis") || t.has("period");
+    if (circle && (t.has("times") || t.has("offsets"))) {
+      t.fail(t.has("times") ? "times" : "offsets",
+             fmt::format("{} gives both keyframes and a circle; expected times and offsets, or "
+                         "centre, axis and period",
+                         t.display_name()));
+    }
+    if (circle) {
+      path.centre = t.required_vec3("centre", "m");
+      path.axis = t.vec3("axis", "", Vec3::UnitZ());
+      if (path.axis == Vec3::Zero()) {
+        t.fail("axis", fmt::format("'axis' in {} is (0, 0, 0); expected a direction [x, y, z], "
+                                   "not zero",
+                                   t.display_name()));
+      }
+      path.axis.normalize();
+      path.period = t.required_number("period", Range::positive("s"));
+    } else {
+      path.offsets = read_keyframes(t, "times", "offsets", "m");
+      if (path.offsets.empty()) {
+        t.fail("pins", fmt::format("{} has no path; expected times and offsets (keyframes), or "
+                                   "centre, axis and period (a circle)",
+                                   t.display_name()));
+      }
+    }
+    scene.pin_paths.push_back(std::move(path));
+  }
+}
+
 // Total mass from `mass` [kg] or from `density` [kg/m^2] times `area` [m^2]: exactly one of the
 // two keys. The total is shared by `count` particles, each of which must keep a mass.
 double read_mass_or_density(SceneTable& t, double area, Index count) {
@@ -177,6 +277,7 @@ void read_rope(SceneTable& t, Scene& scene) {
   };
   for (Index i : read_pins(t, rope.count, named, "first, last, both, none"))
     pin(p, rope.first + i);
+  read_pin_paths(t, scene, rope.first, rope.count, named, "first, last, both, none");
   scene.rope = rope;
 }
 
@@ -214,6 +315,8 @@ void read_cloth(SceneTable& t, Scene& scene) {
        read_pins(t, grid.size(), named, "top-corners, corners, top-edge, left-edge, none")) {
     pin(p, grid.first + i);
   }
+  read_pin_paths(t, scene, grid.first, grid.size(), named,
+                 "top-corners, corners, top-edge, left-edge, none");
   scene.cloth = grid;
   scene.world.triangles = grid_triangles(grid);
 }
@@ -263,6 +366,7 @@ void read_solid(SceneTable& t, Scene& scene) {
   };
   for (Index i : read_pins(t, lattice.size(), named, "top-face, bottom-face, none"))
     pin(p, lattice.first + i);
+  read_pin_paths(t, scene, lattice.first, lattice.size(), named, "top-face, bottom-face, none");
   scene.solid = lattice;
   // Its outside, for the viewer and mesh files, after any cloth's triangles.
   const std::vector<Triangle> surface = solid_surface_triangles(lattice);
@@ -585,12 +689,12 @@ constexpr std::array kKinds = {
                    "[guard] with max_position and max_speed", read_guard},
     SceneTableKind{"particle", true, false, "position velocity mass pinned",
                    "[[particle]] with position, velocity and mass", read_particle},
-    SceneTableKind{"rope", false, false, "start end particles mass pins velocity spin",
+    SceneTableKind{"rope", false, false, "start end particles mass pins velocity spin pin_path",
                    "[rope] with start, end, particles and mass", read_rope},
     SceneTableKind{"cloth", false, false,
-                   "rows cols spacing origin plane mass density pins velocity spin",
+                   "rows cols spacing origin plane mass density pins velocity spin pin_path",
                    "[cloth] with rows, cols, spacing and mass", read_cloth},
-    SceneTableKind{"solid", false, false, "particles size corner mass pins velocity spin",
+    SceneTableKind{"solid", false, false, "particles size corner mass pins velocity spin pin_path",
                    "[solid] with particles, size and mass", read_solid},
     SceneTableKind{"spring", true, false, "i j ks kd l0", "[[spring]] with i, j and ks",
                    read_spring},
@@ -654,6 +758,13 @@ void finish_scene(Scene& scene, const std::function<void(const std::string&)>& f
         "[solid]");
   }
   if (scene.springs.size() > 0) springs_effect(scene);
+  // The pins that move, last: where a path puts a particle is where it is after the step.
+  if (!scene.pin_paths.empty()) {
+    auto pins = std::make_unique<MovingPins>(std::move(scene.pin_paths));
+    pins->place(scene.world.particles, 0.0);
+    scene.world.post_step_effects.push_back(std::move(pins));
+    scene.pin_paths.clear();
+  }
 }
 
 }  // namespace clothlab

@@ -363,6 +363,21 @@ TEST_CASE("scene error: a solid's velocity of two numbers") {
 TEST_CASE("scene error: a spin that starts the cloth's rim beyond the guard's max_speed") {
   check_bad_scene("cloth_spin_beyond_guard.toml");
 }
+TEST_CASE("scene error: a pin path's times that do not increase") {
+  check_bad_scene("pin_path_times_not_increasing.toml");
+}
+TEST_CASE("scene error: a pin path with fewer offsets than times") {
+  check_bad_scene("pin_path_offsets_per_time.toml");
+}
+TEST_CASE("scene error: a pin path with keyframes and a circle") {
+  check_bad_scene("pin_path_keyframes_and_circle.toml");
+}
+TEST_CASE("scene error: a pin circle of period 0") {
+  check_bad_scene("pin_path_zero_period.toml");
+}
+TEST_CASE("scene error: a pin circle given a radius") {
+  check_bad_scene("pin_path_radius.toml");
+}
 
 TEST_CASE("scene error: every bad scene file has a test case") {
   // A file added to tests/scenes/bad/ without a test above would never be checked.
@@ -370,7 +385,7 @@ TEST_CASE("scene error: every bad scene file has a test case") {
   for (const auto& entry : fs::directory_iterator(fs::path(CLOTHLAB_TEST_SCENES) / "bad")) {
     if (entry.path().extension() == ".toml") ++files;
   }
-  CHECK(files == 99);
+  CHECK(files == 104);
 }
 
 TEST_CASE("scene error: a missing file") {

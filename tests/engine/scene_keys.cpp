@@ -130,3 +130,99 @@ duration = 1
   const Index last = scene.rope->first + 4;
   CHECK((Vec3(p.v.col(last)) - Vec3(1.0, 0.5, 0.0)).norm() < 1e-12);  // (1,0,0) + z x (0.5,0,0)
 }
+
+TEST_CASE("scene keys: a keyframed pin is on the straight lines between its keyframes") {
+  clothlab::Scene scene = clothlab::parse_scene(R"(
+[cloth]
+rows = 3
+cols = 3
+spacing = 0.1
+mass = 0.9
+pins = "top-corners"
+[[cloth.pin_path]]
+pins = [0]
+times = [0.0, 0.5, 1.5]
+offsets = [[0, 0, 0], [0.2, 0, 0], [0.2, 0.3, -0.1]]
+[springs]
+ks = 50
+kd = 0.1
+[gravity]
+[integrator]
+dt = 0.01
+duration = 2
+)",
+                                                "wave.toml");
+  clothlab::World& w = scene.world;
+  const Vec3 x0 = w.particles.x.col(0);
+  // The closed form: x0 + d(t), piecewise linear; v = d'(t); held after t = 1.5 s.
+  const auto offset = [](double t) -> Vec3 {
+    if (t < 0.5) return Vec3(0.2, 0, 0) * (t / 0.5);
+    if (t < 1.5) return Vec3(0.2, 0, 0) + Vec3(0, 0.3, -0.1) * ((t - 0.5) / 1.0);
+    return Vec3(0.2, 0.3, -0.1);
+  };
+  const auto velocity = [](double t) -> Vec3 {
+    if (t < 0.5) return Vec3(0.4, 0, 0);
+    if (t < 1.5) return Vec3(0, 0.3, -0.1);
+    return Vec3::Zero();
+  };
+  CHECK((Vec3(w.particles.v.col(0)) - velocity(0.0)).norm() < 1e-15);
+  int checked = 0;
+  for (long s = 1; s <= scene.step_count(); ++s) {
+    w.step(scene.dt);
+    if (s % 25 != 0) continue;  // t = 0.25, 0.5, ..., 2.0 s
+    CAPTURE(w.t);
+    CHECK((Vec3(w.particles.x.col(0)) - (x0 + offset(w.t))).norm() < 1e-12);
+    // At a keyframe's time the velocity jumps: which side a step lands on is rounding's choice.
+    const bool at_keyframe = std::abs(w.t - 0.5) < 1e-9 || std::abs(w.t - 1.5) < 1e-9;
+    if (!at_keyframe) CHECK((Vec3(w.particles.v.col(0)) - velocity(w.t)).norm() < 1e-12);
+    ++checked;
+  }
+  CHECK(checked == 8);
+  CHECK(w.particles.inv_m[0] == 0.0);
+  // The other top corner stays where it was built.
+  CHECK(w.particles.v.col(2).norm() == 0.0);
+}
+
+TEST_CASE("scene keys: a pin on a circle is at the closed-form point, for every integrator") {
+  for (const std::string& method : test::all_integrators()) {
+    CAPTURE(method);
+    clothlab::Scene scene = clothlab::parse_scene(R"(
+[rope]
+start = [0.3, 2, 0]
+end = [0.3, 1, 0]
+particles = 6
+mass = 0.3
+[[rope.pin_path]]
+pins = "first"
+centre = [0, 2, 0]
+axis = [0, 0, 1]
+period = 2
+[springs]
+ks = 100
+kd = 0.05
+[integrator]
+dt = 0.001
+duration = 1
+method = ")" + method + "\"\n",
+                                                  "swing.toml");
+    clothlab::World& w = scene.world;
+    // Turning about z through (0, 2, 0) at w = 2 pi / 2 s = pi rad/s from (0.3, 2, 0):
+    // x = (0.3 cos(pi t), 2 + 0.3 sin(pi t), 0), v = 0.3 pi (-sin(pi t), cos(pi t), 0).
+    for (long s = 1; s <= scene.step_count(); ++s) {
+      w.step(scene.dt);
+      if (s % 250 != 0) continue;
+      CAPTURE(w.t);
+      const double a = kPi * w.t;
+      CHECK(
+          (Vec3(w.particles.x.col(0)) - Vec3(0.3 * std::cos(a), 2 + 0.3 * std::sin(a), 0)).norm() <
+          1e-12);
+      CHECK((Vec3(w.particles.v.col(0)) - 0.3 * kPi * Vec3(-std::sin(a), std::cos(a), 0)).norm() <
+            1e-12);
+    }
+    // No gravity, springs at rest: the rope moves only because its pin drags it. After 1 s
+    // (half a turn) the pin is at (-0.3, 2, 0) and the free end has followed it a long way.
+    const Index end = 5;
+    CHECK((Vec3(w.particles.x.col(end)) - Vec3(0.3, 1, 0)).norm() > 0.1);
+    CHECK(std::isfinite(w.particles.x.col(end).norm()));
+  }
+}

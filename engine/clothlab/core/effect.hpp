@@ -88,6 +88,10 @@ class PostStepEffect {
   // whole world: some post-step effects change more than particles (tearing removes springs
   // and triangles).
   virtual void apply(World& world, double dt) = 0;
+
+  // The energy [J] this effect can give the particles, as ForceEffect::energy_scale says: a pin
+  // that moves can drive them.
+  virtual double energy_scale(const Particles& /*p*/, double /*size*/) const { return 0.0; }
 };
 
 }  // namespace clothlab
