@@ -444,6 +444,29 @@ void read_damping(SceneTable& t, Scene& scene) {
   scene.world.force_effects.push_back(std::make_unique<Damping>(rate));
 }
 
+// The wind of [aerodynamics] or [drag] (wind.hpp): steady (`wind`) or keyframed (`wind_times`,
+// `wind_values`), with gusts (`gust`, `gust_period`) or not.
+Wind read_wind(SceneTable& t) {
+  Wind wind;
+  if (t.has("wind") && t.has("wind_values")) {
+    t.fail("wind_values", fmt::format("{} gives both wind and wind_values; expected a steady wind "
+                                      "or winds at times (wind_times, wind_values)",
+                                      t.display_name()));
+  }
+  wind.steady = t.vec3("wind", "m/s", Vec3::Zero());
+  wind.table = read_keyframes(t, "wind_times", "wind_values", "m/s");
+  if (t.has("gust") != t.has("gust_period")) {
+    t.fail(t.has("gust") ? "gust" : "gust_period",
+           fmt::format("{} has '{}' without '{}'; expected both: gust = [x, y, z] [m/s], the "
+                       "amplitude, and gust_period [s]",
+                       t.display_name(), t.has("gust") ? "gust" : "gust_period",
+                       t.has("gust") ? "gust_period" : "gust"));
+  }
+  wind.gust = t.vec3("gust", "m/s", Vec3::Zero());
+  wind.gust_period = t.number("gust_period", Range::positive("s"), 0.0);
+  return wind;
+}
+
 // [aerodynamics]: air on the cloth's triangles (lesson 03).
 void read_aerodynamics(SceneTable& t, Scene& scene) {
   if (!scene.cloth) {
@@ -451,9 +474,10 @@ void read_aerodynamics(SceneTable& t, Scene& scene) {
   }
   const double rho = t.number("rho", Range::non_negative("kg/m^3"), kAirDensity);
   const double cd = t.number("cd", Range::non_negative(""), 1.0);
-  const Vec3 wind = t.vec3("wind", "m/s", Vec3::Zero());
-  scene.world.force_effects.push_back(
-      std::make_unique<Aerodynamics>(scene.world.triangles, rho, cd, wind));
+  const Wind wind = read_wind(t);
+  auto aerodynamics = std::make_unique<Aerodynamics>(scene.world.triangles, rho, cd, wind.at(0.0));
+  if (wind.changes()) aerodynamics->set_gusts(wind);
+  scene.world.force_effects.push_back(std::move(aerodynamics));
 }
 
 // [drag]: fluid drag on every particle (lesson 03).
@@ -461,8 +485,10 @@ void read_drag(SceneTable& t, Scene& scene) {
   const double rho = t.number("rho", Range::non_negative("kg/m^3"), kAirDensity);
   const double cd = t.number("cd", Range::non_negative(""), 0.47);  // a sphere's
   const double area = t.required_number("area", Range::positive("m^2"));
-  const Vec3 wind = t.vec3("wind", "m/s", Vec3::Zero());
-  scene.world.force_effects.push_back(std::make_unique<FluidDrag>(rho, cd, area, wind));
+  const Wind wind = read_wind(t);
+  auto drag = std::make_unique<FluidDrag>(rho, cd, area, wind.at(0.0));
+  if (wind.changes()) drag->set_gusts(wind);
+  scene.world.force_effects.push_back(std::move(drag));
 }
 
 // [buoyancy]: a fluid below y = surface lifts the particles in it (lesson 03).
@@ -704,9 +730,11 @@ constexpr std::array kKinds = {
     SceneTableKind{"damping", false, false, "rate", "[damping] with rate", read_damping},
     SceneTableKind{"gravity", false, false, "g", "[gravity] with g", read_gravity},
     SceneTableKind{"gravitation", false, false, "G", "[gravitation] with G", read_gravitation},
-    SceneTableKind{"aerodynamics", false, false, "rho cd wind",
+    SceneTableKind{"aerodynamics", false, false,
+                   "rho cd wind wind_times wind_values gust gust_period",
                    "[aerodynamics] with rho, cd and wind", read_aerodynamics},
-    SceneTableKind{"drag", false, false, "rho cd area wind", "[drag] with area", read_drag},
+    SceneTableKind{"drag", false, false, "rho cd area wind wind_times wind_values gust gust_period",
+                   "[drag] with area", read_drag},
     SceneTableKind{"buoyancy", false, false, "rho volume surface g", "[buoyancy] with volume",
                    read_buoyancy},
     // Before the colliders, so that a contact has the last word on where a particle ends up.

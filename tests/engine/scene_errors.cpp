@@ -378,6 +378,12 @@ TEST_CASE("scene error: a pin circle of period 0") {
 TEST_CASE("scene error: a pin circle given a radius") {
   check_bad_scene("pin_path_radius.toml");
 }
+TEST_CASE("scene error: a gust without its period") {
+  check_bad_scene("gust_without_period.toml");
+}
+TEST_CASE("scene error: a steady wind and winds at times") {
+  check_bad_scene("wind_and_wind_values.toml");
+}
 
 TEST_CASE("scene error: every bad scene file has a test case") {
   // A file added to tests/scenes/bad/ without a test above would never be checked.
@@ -385,7 +391,7 @@ TEST_CASE("scene error: every bad scene file has a test case") {
   for (const auto& entry : fs::directory_iterator(fs::path(CLOTHLAB_TEST_SCENES) / "bad")) {
     if (entry.path().extension() == ".toml") ++files;
   }
-  CHECK(files == 104);
+  CHECK(files == 106);
 }
 
 TEST_CASE("scene error: a missing file") {

@@ -226,3 +226,65 @@ method = ")" + method + "\"\n",
     CHECK(std::isfinite(w.particles.x.col(end).norm()));
   }
 }
+
+TEST_CASE("scene keys: wind at a time is the keyframes' plus the gust's sine") {
+  // A 2 x 2 cloth (two triangles, 0.04 m^2 in all) facing z and held at its corners, in wind
+  // along z; a still sheet facing the wind takes F = 1/2 rho cd A w^2 along it. The wind:
+  // keyframes 0 -> 4 m/s over 1 s, then 4 -> 2 m/s over 2 s, plus 1 m/s sin(2 pi t / 0.5 s).
+  // [drag] on each of the four particles: -1/2 rho |u|^2 cd a e with u = -wind, so along +z,
+  // 1/2 rho cd a w^2 each, for the wind 3 + 0.5 sin(2 pi t / 0.25 s).
+  clothlab::Scene scene = clothlab::parse_scene(R"(
+[cloth]
+rows = 2
+cols = 2
+spacing = 0.2
+mass = 0.1
+pins = "corners"
+[aerodynamics]
+rho = 1.2
+cd = 1.1
+wind_times = [0, 1, 3]
+wind_values = [[0, 0, 0], [0, 0, 4], [0, 0, 2]]
+gust = [0, 0, 1]
+gust_period = 0.5
+[drag]
+rho = 1.2
+cd = 0.5
+area = 0.01
+wind = [0, 0, 3]
+gust = [0, 0, 0.5]
+gust_period = 0.25
+[integrator]
+dt = 0.01
+duration = 4
+)",
+                                                "gusts.toml");
+  clothlab::World& w = scene.world;
+  const auto wind_aero = [](double t) {
+    const double steady = t < 1 ? 4 * t : t < 3 ? 4 - (t - 1) : 2;
+    return steady + std::sin(2 * kPi * t / 0.5);
+  };
+  const auto wind_drag = [](double t) { return 3 + 0.5 * std::sin(2 * kPi * t / 0.25); };
+  for (double t : {0.0, 0.1, 0.6, 1.0, 1.7, 2.9, 3.5}) {
+    CAPTURE(t);
+    for (const auto& effect : w.force_effects)
+      effect->set_time(t);
+    const double f_aero = 0.5 * 1.2 * 1.1 * 0.04 * wind_aero(t) * wind_aero(t);
+    const double f_drag = 4 * 0.5 * 1.2 * 0.5 * 0.01 * wind_drag(t) * wind_drag(t);
+    clothlab::Matrix3X f_readable(3, 4), f_fast(3, 4);
+    w.compute_forces_readable(w.particles.x, w.particles.v, f_readable);
+    w.compute_forces(w.particles.x, w.particles.v, f_fast);
+    CHECK(f_readable.row(2).sum() == doctest::Approx(f_aero + f_drag).epsilon(1e-12));
+    CHECK(f_readable.topRows(2).cwiseAbs().maxCoeff() < 1e-12);
+    CHECK((f_fast.array() == f_readable.array()).all());
+  }
+  // World::step gives each effect the time its step starts at.
+  for (int s = 0; s < 137; ++s)
+    w.step(scene.dt);
+  const auto* aero = test::find_force_effect<clothlab::Aerodynamics>(w);
+  const auto* drag = test::find_force_effect<clothlab::FluidDrag>(w);
+  REQUIRE((aero && drag));
+  const double t_last = w.t - scene.dt;  // the last step started here
+  CHECK(aero->wind().z() == doctest::Approx(wind_aero(t_last)).epsilon(1e-12));
+  CHECK(drag->fluid_velocity().z() == doctest::Approx(wind_drag(t_last)).epsilon(1e-12));
+}
