@@ -227,8 +227,9 @@ void read_pin_paths(SceneTable& body, Scene& scene, Index first, Index count,
 }
 
 // Total mass from `mass` [kg] or from `density` [kg/m^2] times `area` [m^2]: exactly one of the
-// two keys. The total is shared by `count` particles, each of which must keep a mass.
-double read_mass_or_density(SceneTable& t, double area, Index count) {
+// two keys. The total is shared by `count` particles, each of which must keep a mass (by area:
+// the least share is 1/count of it).
+double read_mass_or_density(SceneTable& t, double area, Index count, bool by_area) {
   if (t.has("mass") && t.has("density")) {
     t.fail("density", fmt::format("{} gives both mass and density; expected one of the two",
                                   t.display_name()));
@@ -246,8 +247,12 @@ double read_mass_or_density(SceneTable& t, double area, Index count) {
   } else {
     mass = t.required_number("mass", Range::positive("kg"));
   }
-  check_particle_mass(t, t.has("density") ? "density" : "mass", mass / static_cast<double>(count),
-                      fmt::format("the cloth's mass of {} kg shared by {} particles", mass, count));
+  check_particle_mass(
+      t, t.has("density") ? "density" : "mass", mass / static_cast<double>(count),
+      by_area ? fmt::format("a corner's share of the cloth's mass of {} kg by "
+                            "area, 1/{} of it,",
+                            mass, count)
+              : fmt::format("the cloth's mass of {} kg shared by {} particles", mass, count));
   return mass;
 }
 
@@ -300,7 +305,12 @@ void read_cloth(SceneTable& t, Scene& scene) {
   spec.horizontal = t.choice("plane", {"vertical", "horizontal"}, "vertical") == "horizontal";
   const double area = static_cast<double>(spec.rows - 1) * static_cast<double>(spec.cols - 1) *
                       spec.spacing * spec.spacing;
-  spec.mass = read_mass_or_density(t, area, spec.rows * spec.cols);
+  spec.mass_by_area = t.choice("mass_by", {"particle", "area"}, "particle") == "area";
+  // By area, a corner of the grid's diagonal gets a third of one triangle's mass: one in six
+  // cells' worth, the least of any particle.
+  const Index shares =
+      spec.mass_by_area ? 6 * (spec.rows - 1) * (spec.cols - 1) : spec.rows * spec.cols;
+  spec.mass = read_mass_or_density(t, area, shares, spec.mass_by_area);
   Particles& p = scene.world.particles;
   const ClothGrid grid = add_cloth(p, spec);
   // The grid lies between its first particle, at the origin, and its last.
@@ -717,9 +727,10 @@ constexpr std::array kKinds = {
                    "[[particle]] with position, velocity and mass", read_particle},
     SceneTableKind{"rope", false, false, "start end particles mass pins velocity spin pin_path",
                    "[rope] with start, end, particles and mass", read_rope},
-    SceneTableKind{"cloth", false, false,
-                   "rows cols spacing origin plane mass density pins velocity spin pin_path",
-                   "[cloth] with rows, cols, spacing and mass", read_cloth},
+    SceneTableKind{
+        "cloth", false, false,
+        "rows cols spacing origin plane mass density mass_by pins velocity spin pin_path",
+        "[cloth] with rows, cols, spacing and mass", read_cloth},
     SceneTableKind{"solid", false, false, "particles size corner mass pins velocity spin pin_path",
                    "[solid] with particles, size and mass", read_solid},
     SceneTableKind{"spring", true, false, "i j ks kd l0", "[[spring]] with i, j and ks",

@@ -384,6 +384,9 @@ TEST_CASE("scene error: a gust without its period") {
 TEST_CASE("scene error: a steady wind and winds at times") {
   check_bad_scene("wind_and_wind_values.toml");
 }
+TEST_CASE("scene error: an unknown way to share the cloth's mass") {
+  check_bad_scene("unknown_mass_by.toml");
+}
 
 TEST_CASE("scene error: every bad scene file has a test case") {
   // A file added to tests/scenes/bad/ without a test above would never be checked.
@@ -391,7 +394,7 @@ TEST_CASE("scene error: every bad scene file has a test case") {
   for (const auto& entry : fs::directory_iterator(fs::path(CLOTHLAB_TEST_SCENES) / "bad")) {
     if (entry.path().extension() == ".toml") ++files;
   }
-  CHECK(files == 106);
+  CHECK(files == 107);
 }
 
 TEST_CASE("scene error: a missing file") {

@@ -288,3 +288,42 @@ duration = 4
   CHECK(aero->wind().z() == doctest::Approx(wind_aero(t_last)).epsilon(1e-12));
   CHECK(drag->fluid_velocity().z() == doctest::Approx(wind_drag(t_last)).epsilon(1e-12));
 }
+
+TEST_CASE("scene keys: masses by area give the rim half and the corners a sixth or a third") {
+  const auto cloth = [](const std::string& mass_by) {
+    return clothlab::parse_scene(R"(
+[cloth]
+rows = 4
+cols = 5
+spacing = 0.1
+mass = 1.2
+)" + mass_by + R"(
+[integrator]
+dt = 0.01
+duration = 1
+)",
+                                 "masses.toml");
+  };
+  const clothlab::Scene equal = cloth("");
+  CHECK(equal.world.particles.m.sum() == doctest::Approx(1.2));
+  CHECK((equal.world.particles.m.array() == 1.2 / 20).all());
+  const clothlab::Scene by_area = cloth("mass_by = \"area\"");
+  const clothlab::VectorX& m = by_area.world.particles.m;
+  const clothlab::ClothGrid& g = *by_area.cloth;
+  // 3 x 4 cells of 0.1 kg. Inside, a particle touches six triangles of 0.05 kg, a third each: a
+  // cell's mass. On the rim it touches three: half. The cells' diagonals run from (r, c + 1) to
+  // (r + 1, c), so corners (0, 0) and (3, 4) touch one triangle (a sixth), (0, 4) and (3, 0) two.
+  const double cell = 1.2 / 12;
+  CHECK(m.sum() == doctest::Approx(1.2).epsilon(1e-14));
+  CHECK(m[g.at(1, 1)] == doctest::Approx(cell));
+  CHECK(m[g.at(2, 3)] == doctest::Approx(cell));
+  CHECK(m[g.at(0, 2)] == doctest::Approx(cell / 2));
+  CHECK(m[g.at(2, 0)] == doctest::Approx(cell / 2));
+  CHECK(m[g.at(3, 1)] == doctest::Approx(cell / 2));
+  CHECK(m[g.at(1, 4)] == doctest::Approx(cell / 2));
+  CHECK(m[g.at(0, 0)] == doctest::Approx(cell / 6));
+  CHECK(m[g.at(3, 4)] == doctest::Approx(cell / 6));
+  CHECK(m[g.at(0, 4)] == doctest::Approx(cell / 3));
+  CHECK(m[g.at(3, 0)] == doctest::Approx(cell / 3));
+  CHECK((by_area.world.particles.inv_m.array() * m.array() - 1.0).abs().maxCoeff() < 1e-15);
+}
