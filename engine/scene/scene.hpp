@@ -38,7 +38,9 @@ class SceneError : public std::runtime_error {
 };
 
 struct OutputSettings {
-  double fps = 30.0;  // frames written per simulated second [1/s]
+  double fps = 30.0;        // frames written per simulated second [1/s]
+  bool velocities = false;  // also velocities.csv: each particle's velocity, every frame
+  bool springs = false;     // also springs.csv: each spring's strain and tension, every frame
 };
 
 struct Scene {

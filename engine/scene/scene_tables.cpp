@@ -700,6 +700,8 @@ void read_integrator(SceneTable& t, Scene& scene) {
 // [output]: what a run writes.
 void read_output(SceneTable& t, Scene& scene) {
   scene.output.fps = t.number("fps", Range::positive("frames/s"), scene.output.fps);
+  scene.output.velocities = t.boolean("velocities", scene.output.velocities);
+  scene.output.springs = t.boolean("springs", scene.output.springs);
 }
 
 // [guard]: the bounds beyond which a run is stopped as blown up.
@@ -763,7 +765,8 @@ constexpr std::array kKinds = {
                    read_tearing},
     SceneTableKind{"integrator", false, true, "method dt duration tolerance max_iterations",
                    "[integrator] with method, dt [s] and duration [s]", read_integrator},
-    SceneTableKind{"output", false, false, "fps", "[output] with fps", read_output},
+    SceneTableKind{"output", false, false, "fps velocities springs", "[output] with fps",
+                   read_output},
     SceneTableKind{"engine", false, false, "threads fast_path", "[engine] with threads",
                    read_engine},
 };

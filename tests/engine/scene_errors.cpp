@@ -387,6 +387,9 @@ TEST_CASE("scene error: a steady wind and winds at times") {
 TEST_CASE("scene error: an unknown way to share the cloth's mass") {
   check_bad_scene("unknown_mass_by.toml");
 }
+TEST_CASE("scene error: springs output that is not true or false") {
+  check_bad_scene("output_springs_not_bool.toml");
+}
 
 TEST_CASE("scene error: every bad scene file has a test case") {
   // A file added to tests/scenes/bad/ without a test above would never be checked.
@@ -394,7 +397,7 @@ TEST_CASE("scene error: every bad scene file has a test case") {
   for (const auto& entry : fs::directory_iterator(fs::path(CLOTHLAB_TEST_SCENES) / "bad")) {
     if (entry.path().extension() == ".toml") ++files;
   }
-  CHECK(files == 107);
+  CHECK(files == 108);
 }
 
 TEST_CASE("scene error: a missing file") {
