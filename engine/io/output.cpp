@@ -59,7 +59,8 @@ std::string spring_rows(const World& world, long frame) {
       const double l = e_star.norm();
       const Vec3 f1 = spring_damper_force(p.x.col(s.i(k)), p.x.col(s.j(k)), p.v.col(s.i(k)),
                                           p.v.col(s.j(k)), s.ks(k), s.kd(k), s.l0(k));
-      const double tension = l > 0.0 ? f1.dot(e_star) / l : 0.0;
+      // + 0.0: a spring at rest, f_sd = -0, prints as 0.
+      const double tension = (l > 0.0 ? f1.dot(e_star) / l : 0.0) + 0.0;
       const std::string strain =
           s.l0(k) > 0.0 ? fmt::format("{:.17g}", (l - s.l0(k)) / s.l0(k)) : std::string();
       fmt::format_to(std::back_inserter(rows), "{},{:.17g},{},{},{},{},{},{:.17g}\n", frame,
