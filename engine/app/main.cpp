@@ -199,6 +199,12 @@ int main(int argc, char** argv) {
   run_cmd->add_flag("--no-html", no_html, "Write no viewer page");
   run_cmd->add_flag("--obj", obj, "Also write an OBJ sequence to <output folder>/frames/");
   run_cmd->add_flag("--vtk", vtk, "Also write a VTK series to <output folder>/frames/");
+  bool velocities = false, springs = false;
+  run_cmd->add_flag("--velocities", velocities,
+                    "Also write velocities.csv (as [output] velocities = true)");
+  run_cmd->add_flag("--springs", springs,
+                    "Also write springs.csv, each spring's strain and tension (as [output] "
+                    "springs = true)");
   run_cmd->add_flag("--stats", stats,
                     "Print the time spent in each part of the step, on the path that runs");
   bool readable = false;
@@ -236,6 +242,8 @@ int main(int argc, char** argv) {
       if (no_html) outputs.html.clear();
       outputs.obj = obj;
       outputs.vtk = vtk;
+      outputs.velocities = velocities;
+      outputs.springs = springs;
       if (threads >= 0)
         scene.world.threads = threads > 0 ? threads : ThreadTeam::hardware_threads();
       if (readable) scene.world.backend.reset();

@@ -11,7 +11,8 @@
 namespace clothlab {
 
 RunReport run_scene(Scene& scene, const RunOutputs& outputs, const ProgressFn& progress) {
-  FrameWriter writer(outputs.dir);
+  FrameWriter writer(outputs.dir, outputs.velocities || scene.output.velocities,
+                     outputs.springs || scene.output.springs);
   MeshExporter meshes(outputs.dir / "frames", outputs.obj, outputs.vtk);
   RunReport report;
   report.files = writer.files();

@@ -15,6 +15,8 @@ struct RunOutputs {
   std::filesystem::path html;  // the viewer page (empty: no page)
   bool obj = false;            // an OBJ sequence in dir/frames/
   bool vtk = false;            // a VTK series in dir/frames/
+  bool velocities = false;     // velocities.csv, even if the scene's [output] does not ask
+  bool springs = false;        // springs.csv, even if the scene's [output] does not ask
 
   // The usual outputs: the CSV files and dir/view.html.
   static RunOutputs in(const std::filesystem::path& dir) { return {dir, dir / "view.html"}; }

@@ -247,6 +247,80 @@ std::vector<long> SceneTable::integer_list(std::string_view key, long min, long 
   return values;
 }
 
+std::vector<double> SceneTable::number_list(std::string_view key, const Range& range,
+                                            std::string_view what) {
+  std::vector<double> values;
+  const toml::node* node = as_table(node_).get(key);
+  if (!node) return values;
+  const toml::array* array = node->as_array();
+  if (!array) {
+    fail_at(source_, node->source(),
+            fmt::format("'{}' in {} is {}; expected an array of numbers, each {}", key, name_,
+                        clothlab::type_name(*node), describe_range(range)));
+  }
+  for (size_t k = 0; k < array->size(); ++k) {
+    values.push_back(checked_number((*array)[k], source_,
+                                    fmt::format("{} '{}[{}]' in {}", what, key, k, name_), range));
+  }
+  return values;
+}
+
+std::vector<Vec3> SceneTable::vec3_list(std::string_view key, std::string_view unit) {
+  std::vector<Vec3> values;
+  const toml::node* node = as_table(node_).get(key);
+  if (!node) return values;
+  const std::string expected =
+      fmt::format("an array of [x, y, z] arrays, each of three numbers [{}]", unit);
+  const toml::array* array = node->as_array();
+  if (!array) {
+    fail_at(source_, node->source(),
+            fmt::format("'{}' in {} is {}; expected {}", key, name_, clothlab::type_name(*node),
+                        expected));
+  }
+  for (size_t k = 0; k < array->size(); ++k) {
+    const toml::node& element = (*array)[k];
+    const toml::array* xyz = element.as_array();
+    if (!xyz || xyz->size() != 3) {
+      fail_at(source_, element.source(),
+              fmt::format("'{}[{}]' in {} is {}; expected {}", key, k, name_,
+                          xyz ? fmt::format("an array of {} elements", xyz->size())
+                              : std::string(clothlab::type_name(element)),
+                          expected));
+    }
+    Vec3 v;
+    for (int c = 0; c < 3; ++c) {
+      v[c] = checked_number((*xyz)[static_cast<size_t>(c)], source_,
+                            fmt::format("'{}[{}][{}]' in {}", key, k, c, name_), Range::any(unit));
+    }
+    values.push_back(v);
+  }
+  return values;
+}
+
+std::vector<SceneTable> SceneTable::tables(std::string_view key) {
+  std::vector<SceneTable> found;
+  const toml::node* node = as_table(node_).get(key);
+  if (!node) return found;
+  // "[cloth]" -> "cloth": the name of the parent table, for "[[cloth.pin_path]] #1".
+  std::string parent = name_;
+  std::erase_if(parent, [](char c) { return c == '[' || c == ']'; });
+  if (const toml::table* one = node->as_table()) {
+    found.emplace_back(one, fmt::format("[{}.{}]", parent, key), source_);
+    return found;
+  }
+  if (!node->is_array_of_tables()) {
+    fail_at(source_, node->source(),
+            fmt::format("'{}' in {} is {}; expected one or more [[{}.{}]] tables", key, name_,
+                        clothlab::type_name(*node), parent, key));
+  }
+  const toml::array& array = *node->as_array();
+  for (size_t k = 0; k < array.size(); ++k) {
+    found.emplace_back(array[k].as_table(), fmt::format("[[{}.{}]] #{}", parent, key, k + 1),
+                       source_);
+  }
+  return found;
+}
+
 bool SceneTable::boolean(std::string_view key, bool fallback) {
   const toml::node* node = as_table(node_).get(key);
   if (!node) return fallback;

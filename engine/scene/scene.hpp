@@ -13,6 +13,7 @@
 #include <string>
 #include <string_view>
 
+#include "clothlab/after_step/moving_pins.hpp"
 #include "clothlab/bodies/cloth.hpp"
 #include "clothlab/bodies/rope.hpp"
 #include "clothlab/bodies/solid.hpp"
@@ -37,7 +38,9 @@ class SceneError : public std::runtime_error {
 };
 
 struct OutputSettings {
-  double fps = 30.0;  // frames written per simulated second [1/s]
+  double fps = 30.0;        // frames written per simulated second [1/s]
+  bool velocities = false;  // also velocities.csv: each particle's velocity, every frame
+  bool springs = false;     // also springs.csv: each spring's strain and tension, every frame
 };
 
 struct Scene {
@@ -52,7 +55,8 @@ struct Scene {
   std::optional<ClothGrid> cloth;
   std::optional<Rope> rope;
   std::optional<SolidLattice> solid;
-  SpringSet springs;  // structural, shear and one-by-one springs: the "springs" effect
+  SpringSet springs;               // structural, shear and one-by-one springs: the "springs" effect
+  std::vector<PinPath> pin_paths;  // the bodies' moving pins: the "moving_pins" effect
 
   long step_count() const;  // steps needed to cover `duration`
 };

@@ -44,6 +44,13 @@ class SceneTable {
   long required_integer(std::string_view key, long min, long max);
   // An array of whole numbers, each from min to max; `what` names one element in messages.
   std::vector<long> integer_list(std::string_view key, long min, long max, std::string_view what);
+  // An array of numbers, each in range; `what` names one element in messages.
+  std::vector<double> number_list(std::string_view key, const Range& range, std::string_view what);
+  // An array of [x, y, z] arrays [unit].
+  std::vector<Vec3> vec3_list(std::string_view key, std::string_view unit);
+  // The tables under `key`, [[parent.key]] tables or one inline table, each named in messages
+  // "[[parent.key]] #n"; none when the key is absent.
+  std::vector<SceneTable> tables(std::string_view key);
   bool boolean(std::string_view key, bool fallback);
   std::optional<std::string> string(std::string_view key);
   bool has(std::string_view key) const;

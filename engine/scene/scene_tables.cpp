@@ -1,5 +1,6 @@
 #include "scene/scene_tables.hpp"
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <limits>
@@ -8,6 +9,7 @@
 #include <fmt/format.h>
 
 #include "clothlab/after_step/ground_collision.hpp"
+#include "clothlab/after_step/moving_pins.hpp"
 #include "clothlab/after_step/plasticity.hpp"
 #include "clothlab/after_step/self_collision.hpp"
 #include "clothlab/after_step/strain_limiting.hpp"
@@ -78,6 +80,28 @@ void read_particle(SceneTable& t, Scene& scene) {
   if (pinned) pin(scene.world.particles, i);
 }
 
+// `velocity` [m/s] and `spin` [rad/s] of a body, particles [first, first + count): they start
+// moving as one rigid body, v = velocity + spin x (r - c) about their centre of mass c (lesson
+// 09). Called before the pins, which then stop the particles they hold.
+void read_body_motion(SceneTable& t, Scene& scene, Index first, Index count,
+                      std::string_view what) {
+  const Vec3 v0 = t.vec3("velocity", "m/s", Vec3::Zero());
+  const Vec3 w = t.vec3("spin", "rad/s", Vec3::Zero());
+  if (v0 == Vec3::Zero() && w == Vec3::Zero()) return;
+  Particles& p = scene.world.particles;
+  start_moving(p, first, count, v0, w);
+  const double max_speed = scene.world.guard.max_speed;
+  for (Index i = first; i < first + count; ++i) {
+    const Vec3 v = p.v.col(i);
+    if ((v.array().abs() <= max_speed).all()) continue;
+    t.fail(t.has("spin") ? "spin" : "velocity",
+           fmt::format("{} particle {} starts at velocity ({}, {}, {}) m/s, beyond the guard's "
+                       "max_speed = {} m/s; expected each component within {} m/s (a larger "
+                       "max_speed in [guard] allows more)",
+                       what, i - first, v.x(), v.y(), v.z(), max_speed, max_speed));
+  }
+}
+
 // Pins of a builder: a name (e.g. "top-corners") or an array of local indices below `count`.
 std::vector<Index> read_pins(
     SceneTable& t, Index count,
@@ -104,9 +128,108 @@ std::vector<Index> read_pins(
   return pins;
 }
 
+// Keyframes from `times_key` (increasing times [s]) and `values_key` (one [x, y, z] [unit] a
+// time), both given or neither (then none).
+Keyframes read_keyframes(SceneTable& t, std::string_view times_key, std::string_view values_key,
+                         std::string_view unit) {
+  Keyframes frames;
+  if (!t.has(times_key) && !t.has(values_key)) return frames;
+  if (!t.has(times_key)) {
+    t.fail(values_key, fmt::format("{} has '{}' but no '{}'; expected {} = [t0, t1, ...] [s], one "
+                                   "time for each of its values",
+                                   t.display_name(), values_key, times_key, times_key));
+  }
+  if (!t.has(values_key)) {
+    t.fail(times_key, fmt::format("{} has '{}' but no '{}'; expected {} = [[x, y, z], ...] [{}], "
+                                  "one for each time",
+                                  t.display_name(), times_key, values_key, values_key, unit));
+  }
+  frames.t = t.number_list(times_key, Range::non_negative("s"), "time");
+  frames.y = t.vec3_list(values_key, unit);
+  if (frames.t.empty()) {
+    t.fail(times_key, fmt::format("'{}' in {} is empty; expected at least one time [s]", times_key,
+                                  t.display_name()));
+  }
+  for (size_t k = 1; k < frames.t.size(); ++k) {
+    if (frames.t[k] > frames.t[k - 1]) continue;
+    t.fail(times_key, fmt::format("'{}[{}]' in {} is {} s, not after '{}[{}]' = {} s; expected "
+                                  "increasing times",
+                                  times_key, k, t.display_name(), frames.t[k], times_key, k - 1,
+                                  frames.t[k - 1]));
+  }
+  if (frames.y.size() != frames.t.size()) {
+    t.fail(values_key, fmt::format("{} has {} {} for {} times; expected one for each time",
+                                   t.display_name(), frames.y.size(), values_key, frames.t.size()));
+  }
+  return frames;
+}
+
+// A body's [[NAME.pin_path]] tables: pins that follow keyframed offsets or turn on a circle
+// (moving_pins.hpp). The particles they name are pinned; they are put on their paths once the
+// whole scene is read, so that the springs' rest lengths are those of the body as built.
+void read_pin_paths(SceneTable& body, Scene& scene, Index first, Index count,
+                    const std::function<bool(std::string_view, std::vector<Index>&)>& named,
+                    std::string_view names) {
+  Particles& p = scene.world.particles;
+  for (SceneTable& t : body.tables("pin_path")) {
+    t.check_keys("pins times offsets centre axis period");
+    if (!t.has("pins")) {
+      t.fail("pins", fmt::format("{} has no 'pins'; expected pins = a pin set ({}) or an array of "
+                                 "particle indices",
+                                 t.display_name(), names));
+    }
+    PinPath path;
+    for (Index i : read_pins(t, count, named, names)) {
+      for (const PinPath& other : scene.pin_paths) {
+        if (std::find(other.particles.begin(), other.particles.end(), first + i) ==
+            other.particles.end()) {
+          continue;
+        }
+        t.fail("pins", fmt::format("particle {} of {} is on an earlier path already; expected "
+                                   "each particle on one path at most",
+                                   i, t.display_name()));
+      }
+      pin(p, first + i);
+      path.particles.push_back(first + i);
+      path.x0.push_back(p.x.col(first + i));
+    }
+    if (path.particles.empty()) {
+      t.fail("pins", fmt::format("{} moves no particle; expected at least one in 'pins'",
+                                 t.display_name()));
+    }
+    const bool circle = t.has("centre") || t.has("axis") || t.has("period");
+    if (circle && (t.has("times") || t.has("offsets"))) {
+      t.fail(t.has("times") ? "times" : "offsets",
+             fmt::format("{} gives both keyframes and a circle; expected times and offsets, or "
+                         "centre, axis and period",
+                         t.display_name()));
+    }
+    if (circle) {
+      path.centre = t.required_vec3("centre", "m");
+      path.axis = t.vec3("axis", "", Vec3::UnitZ());
+      if (path.axis == Vec3::Zero()) {
+        t.fail("axis", fmt::format("'axis' in {} is (0, 0, 0); expected a direction [x, y, z], "
+                                   "not zero",
+                                   t.display_name()));
+      }
+      path.axis.normalize();
+      path.period = t.required_number("period", Range::positive("s"));
+    } else {
+      path.offsets = read_keyframes(t, "times", "offsets", "m");
+      if (path.offsets.empty()) {
+        t.fail("pins", fmt::format("{} has no path; expected times and offsets (keyframes), or "
+                                   "centre, axis and period (a circle)",
+                                   t.display_name()));
+      }
+    }
+    scene.pin_paths.push_back(std::move(path));
+  }
+}
+
 // Total mass from `mass` [kg] or from `density` [kg/m^2] times `area` [m^2]: exactly one of the
-// two keys. The total is shared by `count` particles, each of which must keep a mass.
-double read_mass_or_density(SceneTable& t, double area, Index count) {
+// two keys. The total is shared by `count` particles, each of which must keep a mass (by area:
+// the least share is 1/count of it).
+double read_mass_or_density(SceneTable& t, double area, Index count, bool by_area) {
   if (t.has("mass") && t.has("density")) {
     t.fail("density", fmt::format("{} gives both mass and density; expected one of the two",
                                   t.display_name()));
@@ -124,8 +247,12 @@ double read_mass_or_density(SceneTable& t, double area, Index count) {
   } else {
     mass = t.required_number("mass", Range::positive("kg"));
   }
-  check_particle_mass(t, t.has("density") ? "density" : "mass", mass / static_cast<double>(count),
-                      fmt::format("the cloth's mass of {} kg shared by {} particles", mass, count));
+  check_particle_mass(
+      t, t.has("density") ? "density" : "mass", mass / static_cast<double>(count),
+      by_area ? fmt::format("a corner's share of the cloth's mass of {} kg by "
+                            "area, 1/{} of it,",
+                            mass, count)
+              : fmt::format("the cloth's mass of {} kg shared by {} particles", mass, count));
   return mass;
 }
 
@@ -147,6 +274,7 @@ void read_rope(SceneTable& t, Scene& scene) {
   // The rope lies between its two ends.
   check_within_guard(t, "start", scene, rope.first, "the rope's first particle");
   check_within_guard(t, "end", scene, rope.first + rope.count - 1, "the rope's last particle");
+  read_body_motion(t, scene, rope.first, rope.count, "the rope's");
   const auto named = [&](std::string_view name, std::vector<Index>& out) {
     if (name == "first" || name == "both") out.push_back(0);
     if (name == "last" || name == "both") out.push_back(rope.count - 1);
@@ -154,6 +282,7 @@ void read_rope(SceneTable& t, Scene& scene) {
   };
   for (Index i : read_pins(t, rope.count, named, "first, last, both, none"))
     pin(p, rope.first + i);
+  read_pin_paths(t, scene, rope.first, rope.count, named, "first, last, both, none");
   scene.rope = rope;
 }
 
@@ -176,13 +305,19 @@ void read_cloth(SceneTable& t, Scene& scene) {
   spec.horizontal = t.choice("plane", {"vertical", "horizontal"}, "vertical") == "horizontal";
   const double area = static_cast<double>(spec.rows - 1) * static_cast<double>(spec.cols - 1) *
                       spec.spacing * spec.spacing;
-  spec.mass = read_mass_or_density(t, area, spec.rows * spec.cols);
+  spec.mass_by_area = t.choice("mass_by", {"particle", "area"}, "particle") == "area";
+  // By area, a corner of the grid's diagonal gets a third of one triangle's mass: one in six
+  // cells' worth, the least of any particle.
+  const Index shares =
+      spec.mass_by_area ? 6 * (spec.rows - 1) * (spec.cols - 1) : spec.rows * spec.cols;
+  spec.mass = read_mass_or_density(t, area, shares, spec.mass_by_area);
   Particles& p = scene.world.particles;
   const ClothGrid grid = add_cloth(p, spec);
   // The grid lies between its first particle, at the origin, and its last.
   check_within_guard(t, "origin", scene, grid.first, "the cloth's first particle");
   check_within_guard(t, "spacing", scene, grid.first + grid.size() - 1,
                      "the cloth's last particle");
+  read_body_motion(t, scene, grid.first, grid.size(), "the cloth's");
   const auto named = [&](std::string_view name, std::vector<Index>& out) {
     return named_pins(grid, name, out);
   };
@@ -190,6 +325,8 @@ void read_cloth(SceneTable& t, Scene& scene) {
        read_pins(t, grid.size(), named, "top-corners, corners, top-edge, left-edge, none")) {
     pin(p, grid.first + i);
   }
+  read_pin_paths(t, scene, grid.first, grid.size(), named,
+                 "top-corners, corners, top-edge, left-edge, none");
   scene.cloth = grid;
   scene.world.triangles = grid_triangles(grid);
 }
@@ -233,11 +370,13 @@ void read_solid(SceneTable& t, Scene& scene) {
   check_within_guard(t, "corner", scene, lattice.first, "the solid's first particle");
   check_within_guard(t, "size", scene, lattice.first + lattice.size() - 1,
                      "the solid's last particle");
+  read_body_motion(t, scene, lattice.first, lattice.size(), "the solid's");
   const auto named = [&](std::string_view name, std::vector<Index>& out) {
     return named_solid_pins(lattice, name, out);
   };
   for (Index i : read_pins(t, lattice.size(), named, "top-face, bottom-face, none"))
     pin(p, lattice.first + i);
+  read_pin_paths(t, scene, lattice.first, lattice.size(), named, "top-face, bottom-face, none");
   scene.solid = lattice;
   // Its outside, for the viewer and mesh files, after any cloth's triangles.
   const std::vector<Triangle> surface = solid_surface_triangles(lattice);
@@ -315,6 +454,29 @@ void read_damping(SceneTable& t, Scene& scene) {
   scene.world.force_effects.push_back(std::make_unique<Damping>(rate));
 }
 
+// The wind of [aerodynamics] or [drag] (wind.hpp): steady (`wind`) or keyframed (`wind_times`,
+// `wind_values`), with gusts (`gust`, `gust_period`) or not.
+Wind read_wind(SceneTable& t) {
+  Wind wind;
+  if (t.has("wind") && t.has("wind_values")) {
+    t.fail("wind_values", fmt::format("{} gives both wind and wind_values; expected a steady wind "
+                                      "or winds at times (wind_times, wind_values)",
+                                      t.display_name()));
+  }
+  wind.steady = t.vec3("wind", "m/s", Vec3::Zero());
+  wind.table = read_keyframes(t, "wind_times", "wind_values", "m/s");
+  if (t.has("gust") != t.has("gust_period")) {
+    t.fail(t.has("gust") ? "gust" : "gust_period",
+           fmt::format("{} has '{}' without '{}'; expected both: gust = [x, y, z] [m/s], the "
+                       "amplitude, and gust_period [s]",
+                       t.display_name(), t.has("gust") ? "gust" : "gust_period",
+                       t.has("gust") ? "gust_period" : "gust"));
+  }
+  wind.gust = t.vec3("gust", "m/s", Vec3::Zero());
+  wind.gust_period = t.number("gust_period", Range::positive("s"), 0.0);
+  return wind;
+}
+
 // [aerodynamics]: air on the cloth's triangles (lesson 03).
 void read_aerodynamics(SceneTable& t, Scene& scene) {
   if (!scene.cloth) {
@@ -322,9 +484,10 @@ void read_aerodynamics(SceneTable& t, Scene& scene) {
   }
   const double rho = t.number("rho", Range::non_negative("kg/m^3"), kAirDensity);
   const double cd = t.number("cd", Range::non_negative(""), 1.0);
-  const Vec3 wind = t.vec3("wind", "m/s", Vec3::Zero());
-  scene.world.force_effects.push_back(
-      std::make_unique<Aerodynamics>(scene.world.triangles, rho, cd, wind));
+  const Wind wind = read_wind(t);
+  auto aerodynamics = std::make_unique<Aerodynamics>(scene.world.triangles, rho, cd, wind.at(0.0));
+  if (wind.changes()) aerodynamics->set_gusts(wind);
+  scene.world.force_effects.push_back(std::move(aerodynamics));
 }
 
 // [drag]: fluid drag on every particle (lesson 03).
@@ -332,8 +495,10 @@ void read_drag(SceneTable& t, Scene& scene) {
   const double rho = t.number("rho", Range::non_negative("kg/m^3"), kAirDensity);
   const double cd = t.number("cd", Range::non_negative(""), 0.47);  // a sphere's
   const double area = t.required_number("area", Range::positive("m^2"));
-  const Vec3 wind = t.vec3("wind", "m/s", Vec3::Zero());
-  scene.world.force_effects.push_back(std::make_unique<FluidDrag>(rho, cd, area, wind));
+  const Wind wind = read_wind(t);
+  auto drag = std::make_unique<FluidDrag>(rho, cd, area, wind.at(0.0));
+  if (wind.changes()) drag->set_gusts(wind);
+  scene.world.force_effects.push_back(std::move(drag));
 }
 
 // [buoyancy]: a fluid below y = surface lifts the particles in it (lesson 03).
@@ -561,6 +726,8 @@ void read_integrator(SceneTable& t, Scene& scene) {
 // [output]: what a run writes.
 void read_output(SceneTable& t, Scene& scene) {
   scene.output.fps = t.number("fps", Range::positive("frames/s"), scene.output.fps);
+  scene.output.velocities = t.boolean("velocities", scene.output.velocities);
+  scene.output.springs = t.boolean("springs", scene.output.springs);
 }
 
 // [guard]: the bounds beyond which a run is stopped as blown up.
@@ -586,11 +753,13 @@ constexpr std::array kKinds = {
                    "[guard] with max_position and max_speed", read_guard},
     SceneTableKind{"particle", true, false, "position velocity mass pinned",
                    "[[particle]] with position, velocity and mass", read_particle},
-    SceneTableKind{"rope", false, false, "start end particles mass pins",
+    SceneTableKind{"rope", false, false, "start end particles mass pins velocity spin pin_path",
                    "[rope] with start, end, particles and mass", read_rope},
-    SceneTableKind{"cloth", false, false, "rows cols spacing origin plane mass density pins",
-                   "[cloth] with rows, cols, spacing and mass", read_cloth},
-    SceneTableKind{"solid", false, false, "particles size corner mass pins",
+    SceneTableKind{
+        "cloth", false, false,
+        "rows cols spacing origin plane mass density mass_by pins velocity spin pin_path",
+        "[cloth] with rows, cols, spacing and mass", read_cloth},
+    SceneTableKind{"solid", false, false, "particles size corner mass pins velocity spin pin_path",
                    "[solid] with particles, size and mass", read_solid},
     SceneTableKind{"spring", true, false, "i j ks kd l0", "[[spring]] with i, j and ks",
                    read_spring},
@@ -600,9 +769,11 @@ constexpr std::array kKinds = {
     SceneTableKind{"damping", false, false, "rate", "[damping] with rate", read_damping},
     SceneTableKind{"gravity", false, false, "g", "[gravity] with g", read_gravity},
     SceneTableKind{"gravitation", false, false, "G", "[gravitation] with G", read_gravitation},
-    SceneTableKind{"aerodynamics", false, false, "rho cd wind",
+    SceneTableKind{"aerodynamics", false, false,
+                   "rho cd wind wind_times wind_values gust gust_period",
                    "[aerodynamics] with rho, cd and wind", read_aerodynamics},
-    SceneTableKind{"drag", false, false, "rho cd area wind", "[drag] with area", read_drag},
+    SceneTableKind{"drag", false, false, "rho cd area wind wind_times wind_values gust gust_period",
+                   "[drag] with area", read_drag},
     SceneTableKind{"buoyancy", false, false, "rho volume surface g", "[buoyancy] with volume",
                    read_buoyancy},
     // Before the colliders, so that a contact has the last word on where a particle ends up.
@@ -622,7 +793,8 @@ constexpr std::array kKinds = {
                    read_tearing},
     SceneTableKind{"integrator", false, true, "method dt duration tolerance max_iterations",
                    "[integrator] with method, dt [s] and duration [s]", read_integrator},
-    SceneTableKind{"output", false, false, "fps", "[output] with fps", read_output},
+    SceneTableKind{"output", false, false, "fps velocities springs", "[output] with fps",
+                   read_output},
     SceneTableKind{"engine", false, false, "threads fast_path", "[engine] with threads",
                    read_engine},
 };
@@ -656,6 +828,13 @@ void finish_scene(Scene& scene, const std::function<void(const std::string&)>& f
         "[solid]");
   }
   if (scene.springs.size() > 0) springs_effect(scene);
+  // The pins that move, last: where a path puts a particle is where it is after the step.
+  if (!scene.pin_paths.empty()) {
+    auto pins = std::make_unique<MovingPins>(std::move(scene.pin_paths));
+    pins->place(scene.world.particles, 0.0);
+    scene.world.post_step_effects.push_back(std::move(pins));
+    scene.pin_paths.clear();
+  }
 }
 
 }  // namespace clothlab

@@ -64,7 +64,7 @@ void turning_wind_table() {
 
 // The sheet of falling-sheet.toml: 11 x 11 particles 0.1 m apart (1 m x 1 m), 0.1 kg, lying
 // flat at y = 10 m. If `by_area`, each particle gets the mass of a third of its triangles'
-// area instead of an equal share.
+// area instead of an equal share (a scene's mass_by = "area").
 World falling_sheet(bool with_air, bool by_area) {
   World world;
   world.integrator = make_integrator("symplectic-euler");
@@ -74,17 +74,10 @@ World falling_sheet(bool with_air, bool by_area) {
   spec.origin = Vec3(-0.5, 10.0, -0.5);
   spec.horizontal = true;
   spec.mass = density * 1.0;
+  spec.mass_by_area = by_area;  // a third of each triangle's mass, a0 = spacing^2 / 2, a corner
   Particles& p = world.particles;
   const ClothGrid grid = add_cloth(p, spec);
   world.triangles = grid_triangles(grid);
-  if (by_area) {
-    p.m.setZero();
-    for (const Triangle& t : world.triangles) {  // a0 = spacing^2 / 2, a third to each corner
-      for (const Index i : t)
-        p.m[i] += density * (0.5 * spec.spacing * spec.spacing) / 3.0;
-    }
-    p.inv_m = p.m.cwiseInverse();
-  }
   SpringSet springs;
   add_spring_family(springs, structural_pairs(grid.rows, grid.cols), grid.first, 100.0, 0.02, p.x);
   add_spring_family(springs, shear_pairs(grid.rows, grid.cols), grid.first, 100.0, 0.02, p.x);

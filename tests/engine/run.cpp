@@ -201,3 +201,83 @@ fps = 10
   CHECK(data["particles"] == 1);
   CHECK(data["frames"].size() == data["times"].size());
 }
+
+TEST_CASE("run: velocities.csv and springs.csv when asked for; a hanging mass's spring pulls m g") {
+  // A 0.5 kg mass on a spring (ks = 100 N/m, l0 = 1 m) from a pin, at rest where the spring
+  // holds its weight: stretched by m g / ks = 0.049 m, a strain of 0.049 and a tension of
+  // m g = 4.9 N, frame after frame.
+  clothlab::Scene scene = clothlab::parse_scene(R"(
+[[particle]]
+position = [0, 0, 0]
+mass = 1
+pinned = true
+[[particle]]
+position = [0, -1.049, 0]
+mass = 0.5
+[[spring]]
+i = 0
+j = 1
+ks = 100
+kd = 0.5
+l0 = 1
+[gravity]
+g = [0, -9.8, 0]
+[integrator]
+dt = 0.001
+duration = 0.5
+[output]
+fps = 10
+velocities = true
+springs = true
+)",
+                                                "hanging.toml");
+  const fs::path dir = fresh_dir("physicist");
+  const clothlab::RunReport report = clothlab::run_scene(scene, dir);
+  REQUIRE(report.frames == 6);
+  CHECK(std::count(report.files.begin(), report.files.end(), dir / "springs.csv") == 1);
+  const auto positions = read_lines(dir / "positions.csv");
+  const auto velocities = read_lines(dir / "velocities.csv");
+  const auto springs = read_lines(dir / "springs.csv");
+  // The same rows as positions.csv: frame, t and particle, then the velocity.
+  REQUIRE(velocities.size() == positions.size());
+  CHECK(velocities[0] == "frame,t,particle,vx,vy,vz");
+  for (size_t k = 1; k < velocities.size(); ++k) {
+    const std::vector<double> v = numbers(velocities[k]), x = numbers(positions[k]);
+    REQUIRE(v.size() == 6);
+    CHECK(v[0] == x[0]);
+    CHECK(v[1] == x[1]);
+    CHECK(v[2] == x[2]);
+    CHECK(std::abs(v[4]) < 1e-9);  // at rest
+  }
+  // The last velocity row is the world's last velocity, to the bit ({:.17g}).
+  CHECK(numbers(velocities.back())[4] == scene.world.particles.v(1, 1));
+  // One row per spring per frame: frame, t, effect, spring, i, j, strain, tension.
+  REQUIRE(springs.size() == 1 + 6);
+  CHECK(springs[0] == "frame,t,effect,spring,i,j,strain,tension");
+  for (size_t k = 1; k < springs.size(); ++k) {
+    CAPTURE(springs[k]);
+    CHECK(springs[k].rfind(std::to_string(k - 1) + ",", 0) == 0);
+    const std::string ends = ",springs,0,0,1,";  // effect, spring 0, from particle 0 to 1
+    const size_t at = springs[k].find(ends);
+    REQUIRE(at != std::string::npos);
+    const std::string numeric = springs[k].substr(at + ends.size());
+    const std::vector<double> row = numbers(numeric);  // strain, tension
+    REQUIRE(row.size() == 2);
+    CHECK(row[0] == doctest::Approx(0.049).epsilon(1e-9));
+    CHECK(row[1] == doctest::Approx(0.5 * 9.8).epsilon(1e-9));
+  }
+  // Without [output] velocities or springs, neither file.
+  clothlab::Scene plain = clothlab::parse_scene(R"(
+[[particle]]
+position = [0, 0, 0]
+mass = 1
+[integrator]
+dt = 0.1
+duration = 0.2
+)",
+                                                "plain.toml");
+  const fs::path plain_dir = fresh_dir("plain");
+  clothlab::run_scene(plain, plain_dir);
+  CHECK(!fs::exists(plain_dir / "velocities.csv"));
+  CHECK(!fs::exists(plain_dir / "springs.csv"));
+}

@@ -14,6 +14,16 @@ ClothGrid add_cloth(Particles& p, const ClothSpec& spec) {
           spec.origin + static_cast<double>(c) * along_row + static_cast<double>(r) * down_rows;
     }
   }
+  if (spec.mass_by_area) {
+    // The total over 2 (rows - 1)(cols - 1) triangles of equal area, a third of each to a corner.
+    const double third = spec.mass / static_cast<double>(6 * (grid.rows - 1) * (grid.cols - 1));
+    p.m.segment(grid.first, n).setZero();
+    for (const Triangle& t : grid_triangles(grid)) {
+      for (const Index i : t)
+        p.m[i] += third;
+    }
+    p.inv_m.segment(grid.first, n) = p.m.segment(grid.first, n).cwiseInverse();
+  }
   return grid;
 }
 

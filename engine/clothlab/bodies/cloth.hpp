@@ -34,10 +34,16 @@ struct ClothSpec {
   Vec3 origin = Vec3::Zero();  // position of particle (0, 0) [m]
   bool horizontal = false;     // false: hangs in the x-y plane, rows going down (-y);
                                // true: lies in the x-z plane, rows going along +z
-  double mass = 1.0;           // total mass [kg], shared equally by the particles
+  double mass = 1.0;           // total mass [kg], shared equally by the particles,
+  bool mass_by_area = false;   // or, if true, in proportion to the area each stands for
 };
 
-// Appends the cloth's particles, at rest, and returns where they are.
+// Appends the cloth's particles, at rest, and returns where they are. Masses by area: each
+// triangle (grid_triangles) gives a third of its mass to each corner, as the air gives each a
+// third of its force (lesson 03). A particle inside the grid touches six triangles and gets a
+// cell's mass; one on the rim three, half of that; a corner one or two (the cells' diagonals run
+// from (r, c + 1) to (r + 1, c)), a sixth or a third.
+
 ClothGrid add_cloth(Particles& p, const ClothSpec& spec);
 
 // The pairs of grid-local indices (r * cols + c) joined by each spring family.

@@ -42,6 +42,11 @@ class ForceEffect {
   // The effect's name as a scene writes it, e.g. "gravity"; used in reports and errors.
   virtual std::string_view name() const = 0;
 
+  // Called by World::step before each step with the time t [s] the step starts at. An effect
+  // whose parameters change in time (a gust of wind) takes their values at t for the whole
+  // step, at every trial state of the integrator.
+  virtual void set_time(double /*t*/) {}
+
   // Adds this effect's force on every particle into f [N], for positions x [m] and velocities
   // v [m/s]. Multi-stage integrators call this at trial states, so an effect reads x and v from
   // the arguments, never from p.x and p.v (p supplies masses and other per-particle data).
@@ -93,6 +98,10 @@ class PostStepEffect {
   // whole world: some post-step effects change more than particles (tearing removes springs
   // and triangles).
   virtual void apply(World& world, double dt) = 0;
+
+  // The energy [J] this effect can give the particles, as ForceEffect::energy_scale says: a pin
+  // that moves can drive them.
+  virtual double energy_scale(const Particles& /*p*/, double /*size*/) const { return 0.0; }
 };
 
 }  // namespace clothlab

@@ -95,6 +95,8 @@ void Guard::start(const World& world) {
   energy_scale_ = world.kinetic_energy();
   for (const auto& effect : world.force_effects)
     energy_scale_ += effect->energy_scale(p, p.x, size);
+  for (const auto& effect : world.post_step_effects)
+    energy_scale_ += effect->energy_scale(p, size);
   x_start_ = p.x;
   released_ = 0.0;
 }

@@ -38,7 +38,8 @@ struct Guard {
   // (kinetic + potential) with what it was at the start: a rise of more than
   // max_energy_growth times the scene's energy scale (the kinetic energy at the start plus
   // what each effect can give: the springs' stored energy, gravity over the scene's size, the
-  // wind's 1/2 M |wind|^2) is energy no force put in, and stops the run.
+  // wind's 1/2 M |wind|^2, a moving pin's 1/2 M v_pin^2) is energy no force put in, and stops
+  // the run.
   double max_energy_growth = 1e4;
   long energy_check_every = 32;
 

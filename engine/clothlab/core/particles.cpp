@@ -29,4 +29,11 @@ Index Particles::grow(Index n, double mass) {
   return first;
 }
 
+void start_moving(Particles& p, Index first, Index count, const Vec3& v0, const Vec3& w) {
+  const VectorX m = p.m.segment(first, count);
+  const Vec3 c = p.x.middleCols(first, count) * m / m.sum();  // sum m r / sum m
+  for (Index i = first; i < first + count; ++i)
+    p.v.col(i) = v0 + w.cross(Vec3(p.x.col(i) - c));
+}
+
 }  // namespace clothlab

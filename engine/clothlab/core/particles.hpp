@@ -28,4 +28,9 @@ struct Particles {
   Index grow(Index n, double mass);
 };
 
+// Sets particles [first, first + count) moving as one rigid body: v = v0 + w x (r - c), with v0
+// [m/s] the velocity of their centre of mass c = sum m r / sum m, and w [rad/s] their angular
+// velocity about it. Their momentum is then M v0, since sum m (r - c) = 0.
+void start_moving(Particles& p, Index first, Index count, const Vec3& v0, const Vec3& w);
+
 }  // namespace clothlab

@@ -36,8 +36,10 @@ class Lap {
 void World::step(double dt) {
   assert(integrator && "a world needs an integrator before it can step");
   if (steps == 0) guard.start(*this);
+  for (const auto& effect : force_effects)
+    effect->set_time(t);  // what changes in time takes its value at the step's start
   for (const auto& effect : post_step_effects)
-    effect->before_step(*this);
+    effect->before_step(*this);  // what needs the state the step starts from records it
   // The backend may take the step, or part of it, its own way with the same bits (backend.hpp),
   // checking the state as it goes; it says what it took, and the world does the rest.
   const BackendStep fast = backend ? backend_step(dt) : BackendStep{};

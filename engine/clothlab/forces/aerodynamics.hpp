@@ -16,10 +16,12 @@
 // triangle's winding flips n, but (v . n) n is unchanged, so the force does not depend on it.
 #pragma once
 
+#include <algorithm>
 #include <vector>
 
 #include "clothlab/core/effect.hpp"
 #include "clothlab/core/triangles.hpp"
+#include "clothlab/forces/wind.hpp"
 
 namespace clothlab {
 
@@ -46,9 +48,15 @@ class Aerodynamics final : public ForceEffect {
   // Wind may change while the simulation runs (a gust, a game's weather).
   void set_wind(const Vec3& v_air) { v_air_ = v_air; }
   const Vec3& wind() const { return v_air_; }  // [m/s]
-  // 1/2 M |wind|^2: the kinetic energy of particles carried along at the wind's speed.
+  // Wind that changes in time by itself (wind.hpp): from then on each step takes its own.
+  void set_gusts(const Wind& gusts) { gusts_ = gusts; }
+  void set_time(double t) override {
+    if (gusts_.changes()) v_air_ = gusts_.at(t);
+  }
+  // 1/2 M |wind|^2: the kinetic energy of particles carried along at the wind's top speed.
   double energy_scale(const Particles& p, const Matrix3X& /*x*/, double /*size*/) const override {
-    return 0.5 * p.m.sum() * v_air_.squaredNorm();
+    const double top = std::max(v_air_.norm(), gusts_.top_speed());
+    return 0.5 * p.m.sum() * top * top;
   }
   double rho() const { return rho_; }  // [kg/m^3]
   double cd() const { return cd_; }
@@ -71,6 +79,7 @@ class Aerodynamics final : public ForceEffect {
   double rho_;  // air density [kg/m^3]
   double cd_;   // drag coefficient
   Vec3 v_air_;  // wind velocity [m/s]
+  Wind gusts_;  // how it changes in time, if it does
 };
 
 class FluidDrag final : public ForceEffect {
@@ -80,9 +89,15 @@ class FluidDrag final : public ForceEffect {
   std::string_view name() const override { return "drag"; }
   void add_forces(const Particles& p, const Matrix3X& x, const Matrix3X& v,
                   Matrix3X& f) const override;
+  // The fluid's flow may change in time (wind.hpp), as the wind on triangles.
+  void set_gusts(const Wind& gusts) { gusts_ = gusts; }
+  void set_time(double t) override {
+    if (gusts_.changes()) v_air_ = gusts_.at(t);
+  }
   // 1/2 M |v_fluid|^2, as for the wind on triangles.
   double energy_scale(const Particles& p, const Matrix3X& /*x*/, double /*size*/) const override {
-    return 0.5 * p.m.sum() * v_air_.squaredNorm();
+    const double top = std::max(v_air_.norm(), gusts_.top_speed());
+    return 0.5 * p.m.sum() * top * top;
   }
   double rho() const { return rho_; }  // [kg/m^3]
   double cd() const { return cd_; }
@@ -94,6 +109,7 @@ class FluidDrag final : public ForceEffect {
   double cd_;    // drag coefficient
   double area_;  // cross-sectional area of each particle [m^2]
   Vec3 v_air_;   // fluid velocity [m/s]
+  Wind gusts_;   // how it changes in time, if it does
 };
 
 // Buoyancy (game-physics lecture): a particle below the fluid's surface is pushed against gravity
