@@ -1,6 +1,7 @@
 // world.hpp: the particles, the effects a scene named, and the step that ties them together.
 //
-// One step, in the lecture's order:
+// One step, in the lecture's order (after the effects have been told the time, set_time, and
+// have recorded what they need of the state the step starts from, before_step):
 //   1. clear the force accumulators;
 //   2. every force effect adds its forces;
 //   3. the integrator advances positions and velocities (re-evaluating 1-2 if it needs to);
