@@ -4,7 +4,6 @@
 #include <cctype>
 #include <cmath>
 #include <fstream>
-#include <sstream>
 #include <vector>
 
 #include <fmt/format.h>
@@ -486,9 +485,76 @@ std::string explain_toml_error(std::string_view text, const toml::parse_error& e
   return what;
 }
 
+// How deep a scene may nest: arrays and inline tables inside each other, or the parts of one
+// dotted key (a.b.c). A scene needs 3 or so; the TOML reader recurses once per level, so a file
+// nested tens of thousands deep would overflow the stack before it could say what is wrong.
+constexpr int kMaxNesting = 64;
+
+// Fails at the first place `text` nests deeper than kMaxNesting, found without parsing: brackets
+// and braces counted outside strings and comments, and the dots of a run of key parts.
+void check_nesting(std::string_view text, const std::string& source) {
+  long line = 1, column = 0;
+  int depth = 0, dots = 0;
+  const auto fail = [&](std::string_view what) {
+    throw SceneError(source, line, column,
+                     fmt::format("{} nest more than {} deep; expected a scene that nests a few "
+                                 "levels (the TOML reader stops here rather than run out of stack)",
+                                 what, kMaxNesting));
+  };
+  for (size_t k = 0; k < text.size(); ++k) {
+    const char c = text[k];
+    ++column;
+    if (c == '\n') {
+      ++line;
+      column = 0;
+      dots = 0;
+      continue;
+    }
+    if (c == '#') {  // a comment, to the end of its line
+      while (k + 1 < text.size() && text[k + 1] != '\n')
+        ++k;
+      continue;
+    }
+    if (c == '"' || c == '\'') {  // a string, basic or literal, on one line or three quotes
+      const bool triple = text.substr(k, 3) == std::string_view(c == '"' ? "\"\"\"" : "'''");
+      const std::string_view close = triple ? text.substr(k, 3) : text.substr(k, 1);
+      for (k += close.size(); k < text.size(); ++k) {
+        if (text[k] == '\n') {
+          ++line;
+          column = 0;
+        } else {
+          ++column;
+        }
+        if (c == '"' && text[k] == '\\') {
+          ++k;  // an escaped character, maybe a quote
+          ++column;
+          continue;
+        }
+        if (text.substr(k, close.size()) == close) {
+          k += close.size() - 1;
+          break;
+        }
+      }
+      continue;
+    }
+    if (c == '[' || c == '{') {
+      if (++depth > kMaxNesting) fail("arrays and inline tables");
+      dots = 0;
+    } else if (c == ']' || c == '}') {
+      depth = std::max(0, depth - 1);
+      dots = 0;
+    } else if (c == '=' || c == ',') {
+      dots = 0;
+    } else if (c == '.') {
+      if (++dots > kMaxNesting) fail("the parts of a dotted key");
+    }
+  }
+}
+
 }  // namespace
 
 Scene parse_scene(std::string_view text, const std::string& source) {
+  check_nesting(text, source);
   toml::table root;
   try {
     root = toml::parse(text, source);
@@ -558,11 +624,33 @@ Scene parse_scene(std::string_view text, const std::string& source) {
 }
 
 Scene load_scene_file(const std::filesystem::path& path) {
+  namespace fs = std::filesystem;
+  const std::string name = path.string();
+  // What the path is, before anything is read: a directory or a device (/dev/zero, a pipe)
+  // is no scene, and a device could be read forever.
+  std::error_code error;
+  const fs::file_status status = fs::status(path, error);
+  if (fs::is_directory(status)) {
+    throw SceneError(name, 1, 1, "is a directory; expected a scene file (.toml)");
+  }
+  if (fs::exists(status) && !fs::is_regular_file(status)) {
+    throw SceneError(name, 1, 1,
+                     "is not a regular file (a device, pipe or socket); expected a scene file "
+                     "(.toml)");
+  }
   std::ifstream in(path, std::ios::binary);
-  if (!in) throw SceneError(path.string(), 1, 1, "cannot open the file; expected a readable scene");
-  std::ostringstream text;
-  text << in.rdbuf();
-  return parse_scene(text.str(), path.string());
+  if (!in) throw SceneError(name, 1, 1, "cannot open the file; expected a readable scene");
+  // At most kMaxSceneBytes, read as such: the file may grow while it is read.
+  std::string text(kMaxSceneBytes + 1, '\0');
+  in.read(text.data(), static_cast<std::streamsize>(text.size()));
+  text.resize(static_cast<size_t>(in.gcount()));
+  if (text.size() > kMaxSceneBytes) {
+    throw SceneError(name, 1, 1,
+                     fmt::format("is larger than {} MiB; expected a scene file (scenes are a few "
+                                 "kilobytes: bodies are built from a few numbers, not listed)",
+                                 kMaxSceneBytes >> 20));
+  }
+  return parse_scene(text, name);
 }
 
 }  // namespace clothlab

@@ -61,7 +61,10 @@ struct Scene {
   long step_count() const;  // steps needed to cover `duration`
 };
 
-// Reads the scene file at `path`. Throws SceneError.
+// The largest scene file read [bytes].
+inline constexpr size_t kMaxSceneBytes = size_t{16} << 20;
+
+// Reads the scene file at `path`: a regular file of at most kMaxSceneBytes. Throws SceneError.
 Scene load_scene_file(const std::filesystem::path& path);
 
 // Reads a scene from `text`; `source` names it in errors (a path, or e.g. "<demo>").

@@ -405,3 +405,58 @@ TEST_CASE("scene error: a missing file") {
                        "no/such/scene.toml:1:1: cannot open the file; expected a readable scene",
                        clothlab::SceneError);
 }
+
+// ---- Inputs that would crash or hang the reader ------------------------------------------------
+
+TEST_CASE("scene error: nesting tens of thousands deep is refused before the TOML reader") {
+  // Once a stack overflow inside the TOML library: a dotted key 40,000 parts deep.
+  std::string dotted = "title = \"deep\"\n";
+  for (int k = 0; k < 40000; ++k)
+    dotted += "a.";
+  dotted += "b = 1\n";
+  CHECK_THROWS_WITH_AS((void)clothlab::parse_scene(dotted, "deep.toml"),
+                       doctest::Contains("deep.toml:2:130: the parts of a dotted key nest more "
+                                         "than 64 deep"),
+                       clothlab::SceneError);
+  // Arrays in arrays, and inline tables in inline tables.
+  const std::string arrays = "x = " + std::string(100000, '[') + std::string(100000, ']') + "\n";
+  CHECK_THROWS_WITH_AS((void)clothlab::parse_scene(arrays, "arrays.toml"),
+                       doctest::Contains("arrays.toml:1:69: arrays and inline tables nest more "
+                                         "than 64 deep"),
+                       clothlab::SceneError);
+  std::string tables = "x = ";
+  for (int k = 0; k < 50000; ++k)
+    tables += "{a = ";
+  CHECK_THROWS_WITH_AS((void)clothlab::parse_scene(tables, "tables.toml"),
+                       doctest::Contains("tables.toml:1:"), clothlab::SceneError);
+  // Brackets and dots inside strings and comments are text, not nesting: this scene is fine.
+  const std::string quoted = "title = \"" + std::string(200, '[') + "\" # " +
+                             std::string(200, '{') +
+                             "\n[[particle]]\nposition = [0.5, 1.5, 2.5]\n"
+                             "mass = 1.0\n[integrator]\ndt = 0.001\nduration = 0.01\n";
+  CHECK_NOTHROW((void)clothlab::parse_scene(quoted, "quoted.toml"));
+}
+
+TEST_CASE("scene error: a directory, a device and a huge file are refused before reading") {
+  const fs::path dir = fs::temp_directory_path() / "clothlab-scene-inputs";
+  fs::create_directories(dir);
+  CHECK_THROWS_WITH_AS(
+      (void)clothlab::load_scene_file(dir),
+      (dir.string() + ":1:1: is a directory; expected a scene file (.toml)").c_str(),
+      clothlab::SceneError);
+  // Once read forever.
+  CHECK_THROWS_WITH_AS((void)clothlab::load_scene_file("/dev/zero"),
+                       "/dev/zero:1:1: is not a regular file (a device, pipe or socket); expected "
+                       "a scene file (.toml)",
+                       clothlab::SceneError);
+  const fs::path huge = dir / "huge.toml";
+  {
+    std::ofstream out(huge);
+    out << "title = \"huge\"\n";
+  }
+  fs::resize_file(huge, clothlab::kMaxSceneBytes + 1);  // sparse: costs no disk
+  CHECK_THROWS_WITH_AS((void)clothlab::load_scene_file(huge),
+                       doctest::Contains(":1:1: is larger than 16 MiB; expected a scene file"),
+                       clothlab::SceneError);
+  fs::remove_all(dir);
+}
