@@ -2,6 +2,10 @@
 
 #include <algorithm>
 #include <chrono>
+#include <stdexcept>
+#include <system_error>
+
+#include <fmt/format.h>
 
 namespace clothlab {
 
@@ -28,16 +32,32 @@ void wait_until(Done done) {
 }  // namespace
 
 ThreadTeam::ThreadTeam(int size) : size_(std::max(1, size)) {
-  for (int t = 1; t < size_; ++t)
-    workers_.emplace_back([this, t] { work(t); });
+  try {
+    for (int t = 1; t < size_; ++t)
+      workers_.emplace_back([this, t] { work(t); });
+  } catch (const std::system_error& error) {
+    // The system would not start another thread (a limit on processes, or on memory): stop the
+    // ones that started and say so, rather than end the program with threads still running.
+    const size_t started = workers_.size() + 1;
+    stop();
+    throw std::runtime_error(fmt::format(
+        "could not start thread {} of the {} asked for ({}); ask for fewer with [engine] threads "
+        "or --threads",
+        started + 1, size_, error.what()));
+  }
 }
 
-ThreadTeam::~ThreadTeam() {
+void ThreadTeam::stop() {
   stop_.store(true);
   generation_.fetch_add(1);
   generation_.notify_all();
   for (std::thread& worker : workers_)
     worker.join();
+  workers_.clear();
+}
+
+ThreadTeam::~ThreadTeam() {
+  stop();
 }
 
 int ThreadTeam::hardware_threads() {

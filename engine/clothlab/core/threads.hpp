@@ -35,6 +35,7 @@ class ThreadTeam {
 
  private:
   void work(int t);
+  void stop();  // ends and joins the workers
   void record(std::exception_ptr error);
 
   int size_;
