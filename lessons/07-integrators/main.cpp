@@ -241,18 +241,6 @@ bool stable(std::string_view method, double y, double w, long steps) {
   return second <= first;
 }
 
-// x >= 0 with `decimals` decimals, rounded down (0.19999 is 0.1999, not 0.2000).
-std::string round_down_to(double x, int decimals) {
-  const double unit = std::pow(10.0, -decimals);
-  // The factor keeps 0.1 from coming out as 999.99999 units; the check undoes a step too far.
-  double q = std::floor(x / unit * (1.0 + 1e-12));
-  for (;;) {
-    const std::string text = fmt::format("{:.{}f}", q * unit, decimals);
-    if (std::stod(text) <= x) return text;
-    q -= 1.0;
-  }
-}
-
 void stability_limits() {
   Scene scene = load_scene_file(lesson_file("spring.toml"));
   const Oscillator osc = oscillator_of(scene);

@@ -45,24 +45,11 @@ namespace {
 
 constexpr double kInfinity = std::numeric_limits<double>::infinity();
 
-// x >= 0 with `decimals` decimals, rounded down: a stable limit printed must hold at exactly the
-// value printed, so 1.23607 is 1.2360, not 1.2361.
-std::string down(double x, int decimals) {
-  const double unit = std::pow(10.0, -decimals);
-  // The factor keeps 0.2 from coming out as 1999.99999 units; the check undoes a step too far.
-  double q = std::floor(x / unit * (1.0 + 1e-12));
-  for (;;) {
-    const std::string text = fmt::format("{:.{}f}", q * unit, decimals);
-    if (std::stod(text) <= x) return text;
-    q -= 1.0;
-  }
-}
-
 // "2.0000", "none" for 0 (unstable at every dt), "any" for infinity; rounded down.
 std::string limit_text(double y) {
   if (y == 0.0) return "none";
   if (std::isinf(y)) return "any";
-  return down(y, 4);
+  return round_down_to(y, 4);
 }
 
 // --- 1. Limits from the step matrix ------------------------------------------------------------
@@ -224,7 +211,8 @@ void engine_limits() {
       (stays_bounded(c.method, c.m0, c.m1, ks, kd, mid) ? lo : hi) = mid;
     }
     fmt::print("   {:<24}  {:>5g}  {:>9.4f}  {:>10}  {:>10}  {:>7.4f}  {}\n", c.label, c.zeta, w,
-               down(1e3 * lo, 4), down(1e3 * expected, 4), lo / expected, c.formula_text);
+               round_down_to(1e3 * lo, 4), round_down_to(1e3 * expected, 4), lo / expected,
+               c.formula_text);
   }
   fmt::print("\n");
 }
@@ -488,8 +476,8 @@ void stiffest_mode(bool dense) {
       "   symplectic Euler's limit [us]: the advisor's {}; from w_max, {} with the "
       "damping\n"
       "   bound and {} undamped; measured on the sheet's springs (bisection): {}\n\n",
-      down(1e6 * advised, 2), down(1e6 * damped, 2), down(1e6 * 2.0 / w_true, 2),
-      down(1e6 * lo, 2));
+      round_down_to(1e6 * advised, 2), round_down_to(1e6 * damped, 2),
+      round_down_to(1e6 * 2.0 / w_true, 2), round_down_to(1e6 * lo, 2));
 }
 
 // --- 6. The stiff sheet, three ways ------------------------------------------------------------

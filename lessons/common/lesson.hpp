@@ -2,10 +2,12 @@
 #pragma once
 
 #include <chrono>
+#include <cmath>
 #include <exception>
 #include <filesystem>
 #include <source_location>
 #include <stdexcept>
+#include <string>
 #include <type_traits>
 
 #include <fmt/format.h>
@@ -60,6 +62,20 @@ int run(const char* program, Body body) {
     return app::kExitFailed;
   }
   return app::kExitOk;
+}
+
+// x >= 0 with `decimals` decimals, rounded down: a stable limit printed must hold at exactly the
+// value printed, so 1.23607 is 1.2360, not 1.2361 (round_down in analysis/stability.hpp does the
+// same with significant digits).
+inline std::string round_down_to(double x, int decimals) {
+  const double unit = std::pow(10.0, -decimals);
+  // The factor keeps 0.2 from coming out as 1999.99999 units; the check undoes a step too far.
+  double q = std::floor(x / unit * (1.0 + 1e-12));
+  for (;;) {
+    const std::string text = fmt::format("{:.{}f}", q * unit, decimals);
+    if (std::stod(text) <= x) return text;
+    q -= 1.0;
+  }
 }
 
 }  // namespace clothlab::lesson
