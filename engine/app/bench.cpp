@@ -33,7 +33,7 @@
 #include "clothlab/forces/gravity.hpp"
 #include "clothlab/integrators/euler.hpp"
 #include "clothlab/integrators/integrator.hpp"
-#include "io/output.hpp"
+#include "io/files.hpp"
 #include "scene/scene.hpp"
 
 extern char** environ;
@@ -240,17 +240,16 @@ int bench_accuracy(const AccuracyOptions& opt) {
   const fs::path out_dir = opt.out;
   fs::create_directories(out_dir);
   const fs::path csv = out_dir / "accuracy.csv";
-  {
-    std::ofstream file = open_for_writing(csv);
-    file << "problem,integrator,dt,steps,error,wall_s_per_sim_s,force_evals_per_sim_s,stable\n";
-    for (const AccuracyRun& run : runs) {
-      file << fmt::format("{},{},{:.17g},{},{:.17g},{:.17g},{:.17g},{}\n", problem->name(),
-                          run.integrator, run.dt, run.steps, run.error, run.wall_per_sim,
-                          run.evals_per_sim, run.stable ? "true" : "false");
-    }
+  std::string table =
+      "problem,integrator,dt,steps,error,wall_s_per_sim_s,force_evals_per_sim_s,stable\n";
+  for (const AccuracyRun& run : runs) {
+    fmt::format_to(std::back_inserter(table), "{},{},{:.17g},{},{:.17g},{:.17g},{:.17g},{}\n",
+                   problem->name(), run.integrator, run.dt, run.steps, run.error, run.wall_per_sim,
+                   run.evals_per_sim, run.stable ? "true" : "false");
   }
+  write_whole_file(csv, table);
   const fs::path script = out_dir / "plot_accuracy.py";
-  open_for_writing(script) << kPlotAccuracyScript;
+  write_whole_file(script, kPlotAccuracyScript);
   fmt::print("\n  wrote {} and {}\n", csv.string(), script.string());
   if (opt.no_plot) return 0;
   const fs::path plot = opt.plot.empty() ? out_dir / "work-precision.svg" : fs::path(opt.plot);

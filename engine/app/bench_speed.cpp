@@ -59,7 +59,7 @@
 #include "fast/engine.hpp"
 #include "fast/forces.hpp"
 #include "fast/springs.hpp"
-#include "io/output.hpp"
+#include "io/files.hpp"
 #include "scene/scene.hpp"
 
 extern char** environ;
@@ -642,12 +642,12 @@ int bench_speed(SpeedOptions opt) {
   if (!opt.csv.empty()) {
     const fs::path csv = opt.csv;
     if (csv.has_parent_path()) fs::create_directories(csv.parent_path());
-    std::ofstream file = open_for_writing(csv);
-    file << "variant,n,threads,springs,ns_per_spring_step,steps_per_s,particles\n";
+    std::string table = "variant,n,threads,springs,ns_per_spring_step,steps_per_s,particles\n";
     for (const Measurement& m : rows) {
-      file << fmt::format("{},{},{},{},{:.6g},{:.6g},{}\n", m.variant, m.n, m.threads, m.springs,
-                          m.ns_per_spring_step, m.steps_per_s, m.n * m.n);
+      fmt::format_to(std::back_inserter(table), "{},{},{},{},{:.6g},{:.6g},{}\n", m.variant, m.n,
+                     m.threads, m.springs, m.ns_per_spring_step, m.steps_per_s, m.n * m.n);
     }
+    write_whole_file(csv, table);
     fmt::print("\n  wrote {}\n", csv.string());
   }
   return 0;

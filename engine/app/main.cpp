@@ -31,7 +31,9 @@
 #include "app/grade.hpp"
 #include "clothlab/core/not_implemented.hpp"
 #include "clothlab/integrators/implicit_euler.hpp"
+#include "io/files.hpp"
 #include "io/run.hpp"
+#include "io/run_folder.hpp"
 #include "scene/scene.hpp"
 
 namespace fs = std::filesystem;
@@ -146,8 +148,25 @@ int run(Scene& scene, const RunOutputs& outputs, bool stats) {
     fmt::print(stderr, "warning: {}\n", advice.warning);
   }
   ProgressBar bar;
+  long steps_done = 0;
+  const auto progress = [&](long done, long total) {
+    steps_done = done;
+    bar(done, total);
+  };
+  // Where the frames are, for a run that ended early.
+  const auto frames_are_in = [&] {
+    std::error_code ec;
+    const bool page = !outputs.html.empty() && fs::exists(outputs.html, ec);
+    return fmt::format(
+        "{}/{}", out_dir.string(),
+        page ? fmt::format(" and the page {} shows them", outputs.html.string()) : std::string());
+  };
+  const auto end_bar = [&] {
+    std::fflush(stdout);  // what was said before the error comes before it
+    if (bar.shown()) fmt::print(stderr, "\n");
+  };
   try {
-    const RunReport report = run_scene(scene, outputs, std::ref(bar));
+    const RunReport report = run_scene(scene, outputs, progress);
     const double energy_end = scene.world.kinetic_energy() + scene.world.potential_energy();
     fmt::print("  done: {} steps in {:.3f} s; total energy {:.6g} J -> {:.6g} J\n", report.steps,
                report.wall_seconds, energy_start, energy_end);
@@ -164,12 +183,29 @@ int run(Scene& scene, const RunOutputs& outputs, bool stats) {
     warn_unconverged(scene.world);
     return 0;
   } catch (const SimulationError& error) {
-    std::fflush(stdout);  // what was said before the error comes before it
-    if (bar.shown()) fmt::print(stderr, "\n");
+    end_bar();
     fmt::print(stderr, "error: {}\n", error.what());
-    fmt::print(stderr, "  frames up to step {} are in {}/{}\n", error.step() - 1, out_dir.string(),
-               outputs.html.empty() ? "" : fmt::format(" and {}", outputs.html.string()));
+    if (error.step() <= 0) {
+      fmt::print(stderr, "  no frame was written\n");
+    } else {
+      fmt::print(stderr, "  frames up to step {} are in {}\n", error.step() - 1, frames_are_in());
+    }
     return app::kExitBlewUp;
+  } catch (const RunStopped& stop) {
+    end_bar();
+    fmt::print(stderr, "{} (t = {:.6g} s): {} frames, the last at that step, are in {}\n",
+               stop.what(), scene.world.t, stop.frames(), frames_are_in());
+    return app::kExitInterrupted;
+  } catch (const OutputError& error) {
+    end_bar();
+    fmt::print(stderr, "error: {}\n", error.what());
+    if (steps_done == 0) {
+      fmt::print(stderr, "  nothing was run\n");
+      return app::kExitBadInput;
+    }
+    fmt::print(stderr, "  the run stopped after step {}; the frames before it are whole in {}\n",
+               steps_done, frames_are_in());
+    return app::kExitFailed;
   }
 }
 
@@ -197,6 +233,10 @@ int main(int argc, char** argv) {
   bool no_html = false, obj = false, vtk = false, stats = false;
   run_cmd->add_option("--html", html, "Viewer page to write (default: <output folder>/view.html)");
   run_cmd->add_flag("--no-html", no_html, "Write no viewer page");
+  bool force = false;
+  run_cmd->add_flag("--force", force,
+                    "Write into an output folder that is not clothlab's (files named as its "
+                    "outputs are replaced), or over a --html file that is not a viewer page");
   run_cmd->add_flag("--obj", obj, "Also write an OBJ sequence to <output folder>/frames/");
   run_cmd->add_flag("--vtk", vtk, "Also write a VTK series to <output folder>/frames/");
   bool velocities = false, springs = false;
@@ -244,6 +284,9 @@ int main(int argc, char** argv) {
       outputs.vtk = vtk;
       outputs.velocities = velocities;
       outputs.springs = springs;
+      // A default folder, clothlab-out/<scene>, holding only what a run writes is taken as
+      // clothlab's even without a marker: it is what a version before the marker left.
+      outputs.force = force || (out_dir.empty() && holds_only_run_outputs(outputs.dir));
       if (threads >= 0)
         scene.world.threads = threads > 0 ? threads : ThreadTeam::hardware_threads();
       if (readable) scene.world.backend.reset();
@@ -269,7 +312,9 @@ int main(int argc, char** argv) {
     if (app.get_subcommands().empty()) {
       // No command: the demo, so that a first run shows something move.
       Scene scene = parse_scene(app::kDemoScene, app::kDemoSceneSource);
-      return run(scene, RunOutputs::in(default_out_dir("demo")), false);
+      RunOutputs outputs = RunOutputs::in(default_out_dir("demo"));
+      outputs.force = holds_only_run_outputs(outputs.dir);
+      return run(scene, outputs, false);
     }
   } catch (const SceneError& error) {
     std::fflush(stdout);

@@ -24,7 +24,7 @@ class MeshExporter {
   // Writes the world's current state as frame number `frame` (numbered from 1 in file names).
   void write(const World& world, long frame);
 
-  // Writes the VTK series index; call once at the end (also after an early stop).
+  // Writes the VTK series index (write() keeps it up to date after each frame).
   void finish() const;
 
  private:

@@ -1,38 +1,47 @@
 #include "io/output.hpp"
 
+#include <cmath>
+#include <string_view>
+
 #include <fmt/format.h>
-#include <fmt/os.h>
+
+#include "clothlab/core/guard.hpp"
 
 #include "clothlab/forces/spring_damper.hpp"
 
 namespace clothlab {
 
-std::ofstream open_for_writing(const std::filesystem::path& path) {
-  std::ofstream out(path, std::ios::trunc);
-  if (!out) throw std::runtime_error(fmt::format("cannot write {}", path.string()));
-  return out;
-}
-
 FrameWriter::FrameWriter(const std::filesystem::path& dir, bool velocities, bool springs) {
-  std::filesystem::create_directories(dir);
   files_ = {dir / "energy.csv", dir / "positions.csv"};
-  energy_ = open_for_writing(files_[0]);
-  positions_ = open_for_writing(files_[1]);
-  energy_ << "frame,t,kinetic,potential,total,px,py,pz\n";
-  positions_ << "frame,t,particle,x,y,z\n";
+  energy_ = AppendFile(files_[0]);
+  positions_ = AppendFile(files_[1]);
+  energy_.append("frame,t,kinetic,potential,total,px,py,pz\n");
+  positions_.append("frame,t,particle,x,y,z\n");
   if (velocities) {
     files_.push_back(dir / "velocities.csv");
-    velocities_ = open_for_writing(files_.back());
-    velocities_ << "frame,t,particle,vx,vy,vz\n";
+    velocities_ = AppendFile(files_.back());
+    velocities_.append("frame,t,particle,vx,vy,vz\n");
   }
   if (springs) {
     files_.push_back(dir / "springs.csv");
-    springs_ = open_for_writing(files_.back());
-    springs_ << "frame,t,effect,spring,i,j,strain,tension\n";
+    springs_ = AppendFile(files_.back());
+    springs_.append("frame,t,effect,spring,i,j,strain,tension\n");
   }
 }
 
 namespace {
+
+// Frame `frame` (after step `step`) would write `what` = `value`, which is not finite.
+[[noreturn]] void refuse_frame(const World& world, long frame, long step, std::string_view what,
+                               double value, Index particle = -1) {
+  throw SimulationError(
+      fmt::format(
+          "frame {} (after step {}, t = {:.6g} s) would write a {} of {}: a number too large "
+          "for a double, or not a number; stopped before writing it (the files hold the "
+          "frames before it)",
+          frame, step, world.t, what, value),
+      step, particle);
+}
 
 // One row per particle of the columns of m: "frame,t,particle,x,y,z".
 std::string particle_rows(const Matrix3X& m, long frame, double t) {
@@ -47,7 +56,7 @@ std::string particle_rows(const Matrix3X& m, long frame, double t) {
 // One row per spring of every spring effect: strain (l - l0) / l0 and tension f_sd, the
 // spring-damper's force on end i along e = (x_j - x_i) / l (lesson 02): positive pulls the ends
 // together.
-std::string spring_rows(const World& world, long frame) {
+std::string spring_rows(const World& world, long frame, long step) {
   const Particles& p = world.particles;
   std::string rows;
   for (const auto& effect : world.force_effects) {
@@ -61,38 +70,64 @@ std::string spring_rows(const World& world, long frame) {
                                           p.v.col(s.j(k)), s.ks(k), s.kd(k), s.l0(k));
       // + 0.0: a spring at rest, f_sd = -0, prints as 0.
       const double tension = (l > 0.0 ? f1.dot(e_star) / l : 0.0) + 0.0;
-      const std::string strain =
-          s.l0(k) > 0.0 ? fmt::format("{:.17g}", (l - s.l0(k)) / s.l0(k)) : std::string();
+      const double strain = s.l0(k) > 0.0 ? (l - s.l0(k)) / s.l0(k) : 0.0;
+      if (!std::isfinite(tension)) refuse_frame(world, frame, step, "spring tension [N]", tension);
+      if (!std::isfinite(strain)) refuse_frame(world, frame, step, "spring strain", strain);
       fmt::format_to(std::back_inserter(rows), "{},{:.17g},{},{},{},{},{},{:.17g}\n", frame,
-                     world.t, family->name(), k, s.i(k), s.j(k), strain, tension);
+                     world.t, family->name(), k, s.i(k), s.j(k),
+                     s.l0(k) > 0.0 ? fmt::format("{:.17g}", strain) : std::string(), tension);
     }
   }
   return rows;
 }
 
+// Throws SimulationError unless every value a frame would write is finite: with the guard's
+// bounds wide enough, 1/2 m v^2 or a spring's energy can overflow to inf though x and v did not.
+void check_finite_frame(const World& world, long frame, long step, double kinetic, double potential,
+                        const Vec3& p) {
+  const auto refuse = [&](std::string_view what, double value, Index particle) {
+    refuse_frame(world, frame, step, what, value, particle);
+  };
+  if (!std::isfinite(world.t)) refuse("time", world.t, -1);
+  if (!std::isfinite(kinetic)) refuse("kinetic energy [J]", kinetic, -1);
+  if (!std::isfinite(potential)) refuse("potential energy [J]", potential, -1);
+  if (!std::isfinite(kinetic + potential)) refuse("total energy [J]", kinetic + potential, -1);
+  if (!p.allFinite()) refuse("momentum [kg m/s]", p.norm(), -1);
+  const Particles& particles = world.particles;
+  for (Index i = 0; i < particles.size(); ++i) {
+    if (!particles.x.col(i).allFinite()) refuse("position [m]", particles.x.col(i).norm(), i);
+    if (!particles.v.col(i).allFinite()) refuse("velocity [m/s]", particles.v.col(i).norm(), i);
+  }
+}
+
 }  // namespace
 
-void FrameWriter::write(const World& world, long frame) {
+void FrameWriter::write(const World& world, long frame, long step) {
   // {:.17g} prints a double so that it reads back bit for bit.
   const double kinetic = world.kinetic_energy();
   const double potential = world.potential_energy();
   const Vec3 p = world.momentum();
-  energy_ << fmt::format("{},{:.17g},{:.17g},{:.17g},{:.17g},{:.17g},{:.17g},{:.17g}\n", frame,
-                         world.t, kinetic, potential, kinetic + potential, p.x(), p.y(), p.z());
-  positions_ << particle_rows(world.particles.x, frame, world.t);
-  energy_.flush();
-  positions_.flush();
-  if (velocities_.is_open()) {
-    velocities_ << particle_rows(world.particles.v, frame, world.t);
-    velocities_.flush();
-  }
-  if (springs_.is_open()) {
-    springs_ << spring_rows(world, frame);
-    springs_.flush();
-  }
-  if (!energy_ || !positions_ || (velocities_.is_open() && !velocities_) ||
-      (springs_.is_open() && !springs_)) {
-    throw std::runtime_error("writing the output files failed");
+  check_finite_frame(world, frame, step, kinetic, potential, p);
+  std::string springs;
+  if (springs_.is_open()) springs = spring_rows(world, frame, step);
+
+  // The frame goes to every file or to none: a file that cannot take it takes it back from
+  // those that did.
+  AppendFile* const files[] = {&positions_, &velocities_, &springs_, &energy_};
+  off_t sizes[std::size(files)];
+  for (size_t k = 0; k < std::size(files); ++k)
+    sizes[k] = files[k]->size();
+  try {
+    positions_.append(particle_rows(world.particles.x, frame, world.t));
+    if (velocities_.is_open()) velocities_.append(particle_rows(world.particles.v, frame, world.t));
+    if (springs_.is_open()) springs_.append(springs);
+    energy_.append(fmt::format("{},{:.17g},{:.17g},{:.17g},{:.17g},{:.17g},{:.17g},{:.17g}\n",
+                               frame, world.t, kinetic, potential, kinetic + potential, p.x(),
+                               p.y(), p.z()));
+  } catch (const OutputError&) {
+    for (size_t k = 0; k < std::size(files); ++k)
+      files[k]->cut_back(sizes[k]);
+    throw;
   }
 }
 

@@ -10,38 +10,39 @@
 //                  l0 = 0), tension = the spring-damper's pull along the spring, f_sd of lesson
 //                  02 (negative: it pushes the ends apart)
 //
-// Every row is flushed as soon as its frame is written, so a run stopped by the guard leaves
-// complete, valid files up to the last good frame.
+// Each frame goes to each file in one piece (io/files.hpp), and a frame some file could not take
+// is cut off all of them: whenever a run stops, by the guard, a signal, a full disk or a crash,
+// every file holds the same whole frames, up to the last good one. No file ever gets an inf or a
+// NaN: a frame that would is refused before anything of it is written.
 #pragma once
 
 #include <filesystem>
-#include <fstream>
 #include <vector>
 
 #include "clothlab/core/world.hpp"
+#include "io/files.hpp"
 
 namespace clothlab {
 
-// Opens `path` for writing, replacing what was there; throws if it cannot.
-std::ofstream open_for_writing(const std::filesystem::path& path);
-
 class FrameWriter {
  public:
-  // Creates `dir` if needed and opens the files, replacing those of an earlier run; with
+  // Opens the files in `dir` (which must exist), replacing those of an earlier run; with
   // `velocities` and `springs`, velocities.csv and springs.csv as well.
   explicit FrameWriter(const std::filesystem::path& dir, bool velocities = false,
                        bool springs = false);
 
-  // Appends frame number `frame` of the world's current state to every file.
-  void write(const World& world, long frame);
+  // Appends frame number `frame` of the world's current state, after step `step`, to every
+  // file. Throws SimulationError, before writing, if a value of the frame is not finite; throws
+  // OutputError if a file cannot take it (the frame is then in none of them).
+  void write(const World& world, long frame, long step);
 
   const std::vector<std::filesystem::path>& files() const { return files_; }
 
  private:
-  std::ofstream energy_;
-  std::ofstream positions_;
-  std::ofstream velocities_;  // open only when asked for
-  std::ofstream springs_;     // open only when asked for
+  AppendFile energy_;
+  AppendFile positions_;
+  AppendFile velocities_;  // open only when asked for
+  AppendFile springs_;     // open only when asked for
   std::vector<std::filesystem::path> files_;
 };
 

@@ -3,14 +3,90 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <csignal>
+#include <cstring>
+#include <string>
+
+#include <fmt/format.h>
 
 #include "io/mesh_export.hpp"
 #include "io/output.hpp"
+#include "io/run_folder.hpp"
 #include "io/viewer.hpp"
 
 namespace clothlab {
 
+namespace {
+
+volatile std::sig_atomic_t g_stop_signal = 0;
+
+extern "C" void on_stop_signal(int signal) {
+  g_stop_signal = signal;
+}
+
+struct sigaction g_old_int {};
+struct sigaction g_old_term {};
+struct sigaction g_old_xfsz {};
+int g_stop_signals_alive = 0;
+
+using Clock = std::chrono::steady_clock;
+
+double seconds_since(Clock::time_point start) {
+  return std::chrono::duration<double>(Clock::now() - start).count();
+}
+
+std::string signal_name(int signal) {
+  const char* abbreviation = sigabbrev_np(signal);
+  return abbreviation ? fmt::format("SIG{}", abbreviation) : fmt::format("signal {}", signal);
+}
+
+}  // namespace
+
+StopSignals::StopSignals() {
+  if (g_stop_signals_alive++ > 0) return;
+  g_stop_signal = 0;
+  struct sigaction sa {};
+  sa.sa_handler = on_stop_signal;
+  sigemptyset(&sa.sa_mask);
+  // SA_RESETHAND: a second Ctrl-C ends the process, for a user who does not want to wait.
+  sa.sa_flags = SA_RESTART | SA_RESETHAND;
+  sigaction(SIGINT, &sa, &g_old_int);
+  sigaction(SIGTERM, &sa, &g_old_term);
+  // A file grown past the size limit (ulimit -f) is an error the writers report with the file's
+  // name (EFBIG), not a signal that ends the process between two frames.
+  struct sigaction ignore {};
+  ignore.sa_handler = SIG_IGN;
+  sigemptyset(&ignore.sa_mask);
+  sigaction(SIGXFSZ, &ignore, &g_old_xfsz);
+}
+
+StopSignals::~StopSignals() {
+  if (--g_stop_signals_alive > 0) return;
+  sigaction(SIGINT, &g_old_int, nullptr);
+  sigaction(SIGTERM, &g_old_term, nullptr);
+  sigaction(SIGXFSZ, &g_old_xfsz, nullptr);
+  g_stop_signal = 0;
+}
+
+int StopSignals::received() {
+  return g_stop_signal;
+}
+
+RunStopped::RunStopped(int signal, long step, long frames)
+    : std::runtime_error(fmt::format("stopped by {} after step {}", signal_name(signal), step)),
+      signal_(signal),
+      step_(step),
+      frames_(frames) {}
+
 RunReport run_scene(Scene& scene, const RunOutputs& outputs, const ProgressFn& progress) {
+  StopSignals stop_signals;
+  // Everything that can be found wrong with the outputs is found before the first step.
+  const bool page = !outputs.html.empty();
+  // A page outside the folder is checked first, so that a bad --html creates no folder.
+  const bool page_inside = page && outputs.html.parent_path() == outputs.dir;
+  if (page && !page_inside) check_page_target(outputs.html, outputs.force);
+  RunFolder folder(outputs.dir, outputs.force);
+  if (page_inside) check_page_target(outputs.html, outputs.force);
   FrameWriter writer(outputs.dir, outputs.velocities || scene.output.velocities,
                      outputs.springs || scene.output.springs);
   MeshExporter meshes(outputs.dir / "frames", outputs.obj, outputs.vtk);
@@ -23,35 +99,62 @@ RunReport run_scene(Scene& scene, const RunOutputs& outputs, const ProgressFn& p
   ViewerRecorder viewer(scene.title, scene.source, total / steps_per_frame + 2);
 
   World& world = scene.world;
+  long step = 0;
   const auto write_frame = [&] {
-    writer.write(world, report.frames);
+    writer.write(world, report.frames, step);
     meshes.write(world, report.frames + 1);  // mesh files count from 1: frame_0001
-    if (!outputs.html.empty()) viewer.offer(world);
+    if (page) viewer.offer(world);
     ++report.frames;
   };
-  // Files that index the frames, and the viewer page, are written however the run ends.
-  const auto finish = [&] {
-    meshes.finish();
-    if (!outputs.html.empty()) viewer.write(world, outputs.html);
+  // The page is rewritten now and then during a long run, so that it is there whatever stops
+  // the run; at most every half minute, and at most a twentieth of the time the run takes.
+  Clock::time_point last_page = Clock::now();
+  double page_seconds = 0.0;  // how long the last page took to write [s]
+  const auto write_page = [&] {
+    const Clock::time_point start = Clock::now();
+    viewer.write(world, outputs.html);
+    page_seconds = seconds_since(start);
+    last_page = Clock::now();
+  };
+  // However the run ends, the page shows the frames written.
+  const auto finish_after_error = [&] {
+    if (!page) return;
+    try {
+      write_page();
+    } catch (const std::exception&) {
+      // The error that ended the run is the one to report; the old page is removed so that no
+      // page of an earlier run stands beside these files.
+      std::error_code ignored;
+      std::filesystem::remove(outputs.html, ignored);
+    }
   };
 
-  write_frame();
-  const auto start = std::chrono::steady_clock::now();
+  const auto start = Clock::now();
   try {
-    for (long s = 1; s <= total; ++s) {
+    write_frame();
+    for (step = 1; step <= total; ++step) {
       world.step(scene.dt);
-      if (s % steps_per_frame == 0 || s == total) write_frame();
-      if (progress) progress(s, total);
+      const bool frame_due = step % steps_per_frame == 0 || step == total;
+      if (frame_due) write_frame();
+      if (progress) progress(step, total);
+      if (const int signal = StopSignals::received(); signal != 0) {
+        if (!frame_due) write_frame();  // the state the user stopped at
+        throw RunStopped(signal, step, report.frames);
+      }
+      if (page && frame_due && seconds_since(last_page) > std::max(30.0, 20.0 * page_seconds)) {
+        write_page();
+      }
     }
-  } catch (const SimulationError&) {
-    finish();
+  } catch (...) {
+    finish_after_error();
     throw;
   }
-  report.wall_seconds =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  report.wall_seconds = seconds_since(start);
   report.steps = total;
-  finish();
-  if (!outputs.html.empty()) report.files.push_back(outputs.html);
+  if (page) {
+    write_page();
+    report.files.push_back(outputs.html);
+  }
   if (outputs.obj || outputs.vtk) report.files.push_back(outputs.dir / "frames");
   return report;
 }

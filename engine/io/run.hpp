@@ -3,6 +3,7 @@
 
 #include <filesystem>
 #include <functional>
+#include <stdexcept>
 #include <vector>
 
 #include "scene/scene.hpp"
@@ -17,6 +18,8 @@ struct RunOutputs {
   bool vtk = false;            // a VTK series in dir/frames/
   bool velocities = false;     // velocities.csv, even if the scene's [output] does not ask
   bool springs = false;        // springs.csv, even if the scene's [output] does not ask
+  bool force = false;  // write into a folder that is not clothlab's, or over a page that is not
+                       // (io/run_folder.hpp)
 
   // The usual outputs: the CSV files and dir/view.html.
   static RunOutputs in(const std::filesystem::path& dir) { return {dir, dir / "view.html"}; }
@@ -32,9 +35,38 @@ struct RunReport {
 // Called after each step with (steps done, steps in all); used for a progress bar.
 using ProgressFn = std::function<void(long, long)>;
 
+// While alive, SIGINT (Ctrl-C) and SIGTERM ask a run to stop after its current step instead of
+// ending the process at once; run_scene then writes that step as a last frame and the page, and
+// throws RunStopped. A second signal ends the process as usual (the files stay whole). SIGXFSZ
+// is ignored meanwhile, so that a file past the size limit is an OutputError that names it.
+class StopSignals {
+ public:
+  StopSignals();
+  ~StopSignals();
+  StopSignals(const StopSignals&) = delete;
+  StopSignals& operator=(const StopSignals&) = delete;
+
+  static int received();  // the signal that asked for a stop, or 0
+};
+
+class RunStopped : public std::runtime_error {
+ public:
+  RunStopped(int signal, long step, long frames);
+  int signal() const { return signal_; }
+  long step() const { return step_; }      // the last step taken
+  long frames() const { return frames_; }  // frames written
+
+ private:
+  int signal_;
+  long step_, frames_;
+};
+
 // Steps `scene` for its whole duration, writing a frame every 1/fps seconds of simulated time
-// (and the first and the last). A SimulationError from the guard propagates after the frames
-// before it have been written and flushed, and the viewer page shows them.
+// (and the first and the last) into the run folder outputs.dir (io/run_folder.hpp), which it
+// takes first; the page's place is checked before the first step, too. However the run ends
+// (its end, the guard's SimulationError, RunStopped, an OutputError from a full disk), the files
+// hold whole frames and the viewer page shows them; the page is also rewritten during a long run
+// (every half minute or so), so that it is there after a crash.
 RunReport run_scene(Scene& scene, const RunOutputs& outputs, const ProgressFn& progress = {});
 
 // The same with the usual outputs in `out_dir`.

@@ -1,0 +1,52 @@
+// run_folder.hpp: the folder a run writes into, and what makes it the run's own.
+//
+// A run writes only into a folder clothlab owns: one it creates, or one holding the marker file
+// .clothlab-run that an earlier run left there. So a run
+//   - never writes into a folder of the user's by surprise: a folder with other things in it and
+//     no marker is refused, unless the user forces it (`clothlab run --force`);
+//   - never leaves the last run's frames beside its own: it clears what the last run wrote
+//     (the names in kRunOutputNames, and frames/frame_NNNN.obj|vtk) before its first frame, and
+//     leaves anything else the user put there alone;
+//   - never shares the folder with another run at the same time: it holds a lock on the marker
+//     while it runs (the system lets the lock go when the process ends, however it ends).
+#pragma once
+
+#include <array>
+#include <filesystem>
+#include <string_view>
+
+namespace clothlab {
+
+// What a run may write in its folder.
+inline constexpr std::array<std::string_view, 8> kRunOutputNames = {
+    "energy.csv",    "positions.csv",  "velocities.csv", "springs.csv",
+    "positions.npy", "velocities.npy", "view.html",      "frames"};
+
+// The marker that says a folder is clothlab's.
+inline constexpr std::string_view kRunFolderMarker = ".clothlab-run";
+
+class RunFolder {
+ public:
+  // Takes `dir` for a run: creates it, or checks it is clothlab's (or empty, or `force`), locks
+  // it, and clears the last run's outputs. Throws OutputError saying what is wrong and what to do.
+  RunFolder(std::filesystem::path dir, bool force);
+  ~RunFolder();  // lets the lock go; the marker stays
+  RunFolder(const RunFolder&) = delete;
+  RunFolder& operator=(const RunFolder&) = delete;
+
+  const std::filesystem::path& dir() const { return dir_; }
+
+ private:
+  std::filesystem::path dir_;
+  int lock_fd_ = -1;
+};
+
+// Whether `dir` is a folder that holds only names a run writes (kRunOutputNames).
+bool holds_only_run_outputs(const std::filesystem::path& dir);
+
+// Throws OutputError if `page` is an existing file that is not a clothlab viewer page (so
+// --html cannot overwrite a user's file by surprise) unless `force`, or if no file can be
+// written where it goes.
+void check_page_target(const std::filesystem::path& page, bool force);
+
+}  // namespace clothlab
