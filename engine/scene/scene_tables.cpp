@@ -465,6 +465,25 @@ void read_spring(SceneTable& t, Scene& scene) {
   }
 }
 
+// Warns at 'ks' of [springs] or [bending] when springs `from` on include some of rest length 0:
+// their ends start at one point, where the body's spacing is too small to tell them apart
+// (1 + 1e-300 is 1).
+void warn_zero_rest_lengths(SceneTable& t, Scene& scene, const SpringSet& springs, size_t from) {
+  size_t zero = 0, first = 0;
+  for (size_t k = from; k < springs.size(); ++k) {
+    if (springs.l0(k) == 0.0 && zero++ == 0) first = k;
+  }
+  if (zero == 0) return;
+  t.warn(scene, "ks",
+         fmt::format("{} makes {} spring{} of rest length 0, the first from particle {} to {}: "
+                     "their ends start at the same position, so with no rest length their strain "
+                     "(l - l0) / l0 is undefined and they pull their ends together until they "
+                     "meet; give the body a spacing (or size) large enough to tell its particles "
+                     "apart where it is",
+                     t.display_name(), zero, zero == 1 ? "" : "s", springs.i(first),
+                     springs.j(first)));
+}
+
 // [springs]: structural and shear springs of the cloth, the rope's springs (lesson 02), the
 // solid's edges and diagonals (lesson 09).
 void read_springs(SceneTable& t, Scene& scene) {
@@ -478,6 +497,7 @@ void read_springs(SceneTable& t, Scene& scene) {
   const double shear_ks = t.number("shear_ks", Range::non_negative("N/m"), ks);
   const double shear_kd = t.number("shear_kd", Range::non_negative("N s/m"), kd);
   const Matrix3X& x = scene.world.particles.x;
+  const size_t from = scene.springs.size();  // after the [[spring]] tables' springs
   if (scene.rope)
     add_spring_family(scene.springs, rope_pairs(scene.rope->count), scene.rope->first, ks, kd, x);
   if (scene.cloth) {
@@ -495,6 +515,7 @@ void read_springs(SceneTable& t, Scene& scene) {
     add_spring_family(scene.springs, solid_body_diagonal_pairs(g.nx, g.ny, g.nz), g.first, shear_ks,
                       shear_kd, x);
   }
+  warn_zero_rest_lengths(t, scene, scene.springs, from);
 }
 
 // [bending]: flexion springs two apart, with their own constants (lesson 04).
@@ -510,6 +531,7 @@ void read_bending(SceneTable& t, Scene& scene) {
   if (scene.rope) {
     add_spring_family(bending, rope_bending_pairs(scene.rope->count), scene.rope->first, ks, kd, x);
   }
+  warn_zero_rest_lengths(t, scene, bending, 0);
   scene.world.force_effects.push_back(
       std::make_unique<SpringDampers>("bending", std::move(bending)));
 }

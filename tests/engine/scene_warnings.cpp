@@ -117,6 +117,24 @@ TEST_CASE("scene warning: a spring of rest length zero") {
   CHECK(scene.warnings[1].text().starts_with("same.toml:5:12: particle 1 ([[particle]] #2)"));
 }
 
+TEST_CASE("scene warning: a body's springs of rest length zero") {
+  // A spacing of 1e-300 m at x = 1 m: 1 + 1e-300 is 1, so the 2 x 2 cloth's four particles start
+  // at one point, and its 4 structural and 2 shear springs have rest length 0.
+  const std::string text =
+      "[cloth]\nrows = 2\ncols = 2\nspacing = 1e-300\norigin = [1, 1, 1]\n"
+      "mass = 1\n[springs]\nks = 10\n" +
+      kIntegrator;
+  const clothlab::Scene scene = clothlab::parse_scene(text, "tiny.toml");
+  REQUIRE(scene.warnings.size() == 2);
+  CHECK(scene.warnings[0].text().starts_with(
+      "tiny.toml:8:6: [springs] makes 6 springs of rest length 0, the first from particle 0 to 1: "
+      "their ends start at the same position, so with no rest length their strain (l - l0) / l0 "
+      "is undefined"));
+  CHECK(scene.warnings[1].text().starts_with(
+      "tiny.toml:5:10: particle 1 (the cloth's particle 1 (row 0, column 1)) starts at (1, 1, 1) "
+      "m, exactly where particle 0 (the cloth's particle 0 (row 0, column 0)) does (3 particles"));
+}
+
 TEST_CASE("scene warning: particles that start at the same position") {
   // #3 and #5 start where #1 does, #4 where #2 does: three in all; the first pair is (0, 2), at
   // #3's position (line 8, column 12).
