@@ -209,6 +209,9 @@ void read_pin_paths(SceneTable& body, Scene& scene, Index first, Index count,
   std::vector<bool> fixed(static_cast<size_t>(count));
   for (Index i = 0; i < count; ++i)
     fixed[static_cast<size_t>(i)] = p.inv_m[first + i] == 0.0;
+  // The particles on the body's earlier paths, one mark each: comparing each pin with every
+  // earlier path's pins made 10^12 comparisons for two paths of 10^6 pins.
+  std::vector<bool> on_path(static_cast<size_t>(count));
   for (SceneTable& t : body.tables("pin_path")) {
     t.check_keys("pins times offsets centre axis period");
     if (!t.has("pins")) {
@@ -230,11 +233,7 @@ void read_pin_paths(SceneTable& body, Scene& scene, Index first, Index count,
              t.is_array("pins") ? std::optional<size_t>(k) : std::nullopt);
     }
     for (Index i : pins) {
-      for (const PinPath& other : scene.pin_paths) {
-        if (std::find(other.particles.begin(), other.particles.end(), first + i) ==
-            other.particles.end()) {
-          continue;
-        }
+      if (on_path[static_cast<size_t>(i)]) {
         t.fail("pins", fmt::format("particle {} of {} is on an earlier path already; expected "
                                    "each particle on one path at most",
                                    i, t.display_name()));
@@ -272,6 +271,8 @@ void read_pin_paths(SceneTable& body, Scene& scene, Index first, Index count,
                                    t.display_name()));
       }
     }
+    for (Index i : pins)
+      on_path[static_cast<size_t>(i)] = true;
     scene.pin_paths.push_back(std::move(path));
   }
 }

@@ -447,6 +447,26 @@ TEST_CASE("scene error: nesting tens of thousands deep is refused before the TOM
   CHECK_NOTHROW((void)clothlab::parse_scene(quoted, "quoted.toml"));
 }
 
+TEST_CASE("scene error: a particle on two long pin paths is found without comparing every pair") {
+  // Two paths of 200,000 pins each, the second ending on a particle of the first: comparing each
+  // pin with every earlier one made 4e10 comparisons before the error; one mark each is instant.
+  std::string first = "[", second = "[";
+  for (int k = 0; k < 200000; ++k) {
+    first += std::to_string(k) + ", ";
+    second += std::to_string(200000 + k) + ", ";
+  }
+  const std::string text =
+      "[cloth]\nrows = 400\ncols = 1000\nspacing = 0.01\nmass = 1\n"
+      "[[cloth.pin_path]]\npins = " +
+      first + "]\ntimes = [0]\noffsets = [[0, 0, 0]]\n" + "[[cloth.pin_path]]\npins = " + second +
+      "7]\ntimes = [0]\noffsets = [[0, 0, 0]]\n"
+      "[integrator]\ndt = 0.01\nduration = 1\n";
+  CHECK_THROWS_WITH_AS((void)clothlab::parse_scene(text, "paths.toml"),
+                       "paths.toml:11:8: particle 7 of [[cloth.pin_path]] #2 is on an earlier path "
+                       "already; expected each particle on one path at most",
+                       clothlab::SceneError);
+}
+
 TEST_CASE("scene error: a directory, a device and a huge file are refused before reading") {
   const fs::path dir = fs::temp_directory_path() / "clothlab-scene-inputs";
   fs::create_directories(dir);
