@@ -132,6 +132,13 @@ void warn_unconverged(const World& world) {
              s.unconverged, s.solves, implicit->max_iterations, s.worst_error, implicit->tolerance);
 }
 
+// The scene reader's warnings: inputs that run but are likely mistakes, each with FILE:LINE:COL.
+void print_scene_warnings(const Scene& scene) {
+  std::fflush(stdout);  // after what was printed before them
+  for (const SceneWarning& warning : scene.warnings)
+    fmt::print(stderr, "warning: {}\n", warning.text());
+}
+
 int run(Scene& scene, const RunOutputs& outputs, bool stats) {
   const fs::path& out_dir = outputs.dir;
   StepTimes times;
@@ -140,6 +147,7 @@ int run(Scene& scene, const RunOutputs& outputs, bool stats) {
              scene.title.empty() ? "" : " - " + scene.title);
   fmt::print("  {}; {}; dt = {} s for {} s ({} steps)\n", particle_count(scene),
              scene.world.effects_in_play(), scene.dt, scene.duration, scene.step_count());
+  print_scene_warnings(scene);
   const double energy_start = scene.world.kinetic_energy() + scene.world.potential_energy();
   // The time-step advisor speaks before the run, so a user who sees it blow up knows why.
   const TimeStepAdvice advice = advise_time_step(scene.world, scene.dt, scene.step_count());
@@ -297,6 +305,7 @@ int main(int argc, char** argv) {
       fmt::print("{}: ok: {}; {}; dt = {} s for {} s ({} steps)\n", validate_path,
                  particle_count(scene), scene.world.effects_in_play(), scene.dt, scene.duration,
                  scene.step_count());
+      print_scene_warnings(scene);
       const TimeStepAdvice advice = advise_time_step(scene.world, scene.dt, scene.step_count());
       if (advice.bounds.omega_max > 0.0) {
         fmt::print("  stiffest mode: w <= {:.4g} rad/s; stable time step for {}: {}\n",

@@ -12,6 +12,7 @@
 #include "fast/engine.hpp"
 #include "scene/scene_reader.hpp"
 #include "scene/scene_tables.hpp"
+#include "scene/scene_warnings.hpp"
 
 namespace clothlab {
 
@@ -22,6 +23,10 @@ SceneError::SceneError(const std::string& source, long line, long column,
       line_(line),
       column_(column),
       message_(message) {}
+
+std::string SceneWarning::text() const {
+  return fmt::format("{}:{}:{}: {}", source, line, column, message);
+}
 
 long Scene::step_count() const {
   // duration / dt rounded to the nearest whole step (1.0 / 0.01 is 100.00000000000001).
@@ -111,6 +116,19 @@ void SceneTable::fail(std::string_view key, const std::string& message) const {
   const toml::table& table = as_table(node_);
   const toml::node* value = table.get(key);
   fail_at(source_, value ? value->source() : table.source(), message);
+}
+
+void SceneTable::warn(Scene& scene, std::string_view key, const std::string& message,
+                      std::optional<size_t> element) const {
+  const toml::table& table = as_table(node_);
+  const toml::node* value = table.get(key);
+  if (value && element) {
+    const toml::array* array = value->as_array();
+    if (array && *element < array->size()) value = array->get(*element);
+  }
+  const toml::source_region where = value ? value->source() : table.source();
+  scene.warnings.push_back({source_, static_cast<long>(where.begin.line),
+                            static_cast<long>(where.begin.column), message});
 }
 
 namespace {
@@ -551,6 +569,52 @@ void check_nesting(std::string_view text, const std::string& source) {
   }
 }
 
+// Where particle i was made: its [[particle]] table's position, or the key of its body's table
+// that places it (the table itself when the key is absent). [[particle]] tables are read first,
+// so particle i < their count is table #i + 1.
+toml::source_region particle_source(const toml::table& root, const Scene& scene, Index i) {
+  const auto at = [&](std::string_view table, std::string_view key) {
+    const toml::node* t = root.get(table);
+    const toml::node* k = t && t->is_table() ? t->as_table()->get(key) : nullptr;
+    return k ? k->source() : t ? t->source() : toml::source_region{};
+  };
+  if (const toml::array* particles = root["particle"].as_array();
+      particles && i < static_cast<Index>(particles->size())) {
+    const toml::table& t = *particles->get(static_cast<size_t>(i))->as_table();
+    return t.contains("position") ? t.get("position")->source() : t.source();
+  }
+  if (scene.rope && i >= scene.rope->first && i < scene.rope->first + scene.rope->count) {
+    return at("rope", "start");
+  }
+  if (scene.cloth && i >= scene.cloth->first && i < scene.cloth->first + scene.cloth->size()) {
+    return at("cloth", root["cloth"]["origin"] ? "origin" : "spacing");
+  }
+  return at("solid", root["solid"]["corner"] ? "corner" : "size");
+}
+
+// The warnings that need the whole scene: particles that start at one point, and an all-pairs
+// effect on many particles.
+void warn_about_whole_scene(const toml::table& root, Scene& scene) {
+  const auto warn = [&](const toml::source_region& where, const std::string& message) {
+    scene.warnings.push_back({scene.source, static_cast<long>(where.begin.line),
+                              static_cast<long>(where.begin.column), message});
+  };
+  const Matrix3X& x = scene.world.particles.x;
+  if (const CoincidentParticles c = find_coincident_particles(x); c.count > 0) {
+    const Vec3 at = x.col(c.second);
+    warn(particle_source(root, scene, c.second),
+         fmt::format("particle {} ({}) starts at ({}, {}, {}) m, exactly where particle {} ({}) "
+                     "does ({} particle{} in all start where a lower-numbered one does); between "
+                     "particles at one point a force has no direction (a spring has no rest "
+                     "length, gravitation skips the pair): give each particle its own position",
+                     c.second, describe_particle(scene, c.second), at.x(), at.y(), at.z(), c.first,
+                     describe_particle(scene, c.first), c.count, c.count == 1 ? "" : "s"));
+  }
+  if (const std::string cost = all_pairs_warning(scene); !cost.empty()) {
+    warn(root["gravitation"].node()->source(), cost);
+  }
+}
+
 }  // namespace
 
 Scene parse_scene(std::string_view text, const std::string& source) {
@@ -620,6 +684,7 @@ Scene parse_scene(std::string_view text, const std::string& source) {
     }
   }
   finish_scene(scene, [&](const std::string& message) { fail_at(source, top, message); });
+  warn_about_whole_scene(root, scene);
   return scene;
 }
 

@@ -4,7 +4,9 @@
 // a table that is present is simulated, one that is absent is never constructed. Anything the
 // reader does not understand is an error of the form
 //   FILE:LINE:COL: what is wrong; what was expected
-// raised before anything is simulated or written.
+// raised before anything is simulated or written. An input that runs but is likely a mistake (a
+// particle pinned twice, fps above the step rate, ...) is a warning of the same form instead,
+// kept in Scene::warnings for the caller to print.
 #pragma once
 
 #include <filesystem>
@@ -12,6 +14,7 @@
 #include <stdexcept>
 #include <string>
 #include <string_view>
+#include <vector>
 
 #include "clothlab/after_step/moving_pins.hpp"
 #include "clothlab/bodies/cloth.hpp"
@@ -37,6 +40,15 @@ class SceneError : public std::runtime_error {
   std::string message_;
 };
 
+// Something odd about a scene that still runs: where it is, what is odd and what to do.
+struct SceneWarning {
+  std::string source;
+  long line = 1;
+  long column = 1;
+  std::string message;       // "what is odd; what to do"
+  std::string text() const;  // "FILE:LINE:COL: message"
+};
+
 struct OutputSettings {
   double fps = 30.0;        // frames written per simulated second [1/s]
   bool velocities = false;  // also velocities.csv: each particle's velocity, every frame
@@ -50,6 +62,7 @@ struct Scene {
   double dt = 0.0;        // time step [s]
   double duration = 0.0;  // simulated time [s]
   OutputSettings output;
+  std::vector<SceneWarning> warnings;  // inputs that run but are likely mistakes, as found
 
   // What the builders made, for the tables read after them (springs, bending, aerodynamics).
   std::optional<ClothGrid> cloth;

@@ -65,6 +65,11 @@ class SceneTable {
   // Raises a SceneError at `key` (or at the table itself when the key is absent).
   [[noreturn]] void fail(std::string_view key, const std::string& message) const;
 
+  // Adds a warning at `key` (at its element `element`, if given, when it is an array; at the
+  // table itself when the key is absent) to `scene`.
+  void warn(Scene& scene, std::string_view key, const std::string& message,
+            std::optional<size_t> element = std::nullopt) const;
+
   // Raises a SceneError for the first key that is not in `known` (names separated by spaces),
   // suggesting the nearest known name.
   void check_keys(std::string_view known) const;

@@ -102,9 +102,40 @@ void read_body_motion(SceneTable& t, Scene& scene, Index first, Index count,
   }
 }
 
+// Warns at the first element of the array 'pins' that repeats an earlier one: a particle is
+// pinned once, so the repeat does nothing and is likely a typo for another index. Sorting the
+// (index, place) pairs finds repeats in O(k log k) for k pins, not by comparing every pair.
+void warn_repeated_pins(SceneTable& t, Scene& scene, const std::vector<Index>& pins) {
+  std::vector<std::pair<Index, size_t>> sorted(pins.size());
+  for (size_t k = 0; k < pins.size(); ++k)
+    sorted[k] = {pins[k], k};
+  std::sort(sorted.begin(), sorted.end());
+  size_t repeats = 0, first = 0, repeat = pins.size();  // repeat: the earliest repeating place
+  size_t run = 0;  // where the run of equal indices that sorted[k] is in starts
+  for (size_t k = 1; k < sorted.size(); ++k) {
+    if (sorted[k].first != sorted[k - 1].first) {
+      run = k;
+      continue;
+    }
+    ++repeats;
+    if (sorted[k].second < repeat) {
+      repeat = sorted[k].second;
+      first = sorted[run].second;  // the same index's first place
+    }
+  }
+  if (repeats == 0) return;
+  t.warn(
+      scene, "pins",
+      fmt::format("'pins[{}]' in {} pins particle {} again, as 'pins[{}]' does ({} repeat{} in "
+                  "all); a particle is pinned once, so a repeat does nothing: remove it, or "
+                  "write the index you meant",
+                  repeat, t.display_name(), pins[repeat], first, repeats, repeats == 1 ? "" : "s"),
+      repeat);
+}
+
 // Pins of a builder: a name (e.g. "top-corners") or an array of local indices below `count`.
 std::vector<Index> read_pins(
-    SceneTable& t, Index count,
+    SceneTable& t, Scene& scene, Index count,
     const std::function<bool(std::string_view, std::vector<Index>&)>& named,
     std::string_view names) {
   std::vector<Index> pins;
@@ -124,6 +155,7 @@ std::vector<Index> read_pins(
     for (long i : t.integer_list("pins", 0, static_cast<long>(count) - 1, "pin index")) {
       pins.push_back(i);
     }
+    warn_repeated_pins(t, scene, pins);  // a pin set never repeats; an array may
   }
   return pins;
 }
@@ -170,7 +202,16 @@ Keyframes read_keyframes(SceneTable& t, std::string_view times_key, std::string_
 void read_pin_paths(SceneTable& body, Scene& scene, Index first, Index count,
                     const std::function<bool(std::string_view, std::vector<Index>&)>& named,
                     std::string_view names) {
+  if (!body.has("pin_path")) return;
   Particles& p = scene.world.particles;
+  // The body's fixed pins ('pins'), read before its paths: a path that also holds one of them
+  // moves it, and the fixed pin does nothing.
+  std::vector<bool> fixed(static_cast<size_t>(count));
+  for (Index i = 0; i < count; ++i)
+    fixed[static_cast<size_t>(i)] = p.inv_m[first + i] == 0.0;
+  // The particles on the body's earlier paths, one mark each: comparing each pin with every
+  // earlier path's pins made 10^12 comparisons for two paths of 10^6 pins.
+  std::vector<bool> on_path(static_cast<size_t>(count));
   for (SceneTable& t : body.tables("pin_path")) {
     t.check_keys("pins times offsets centre axis period");
     if (!t.has("pins")) {
@@ -179,12 +220,20 @@ void read_pin_paths(SceneTable& body, Scene& scene, Index first, Index count,
                                  t.display_name(), names));
     }
     PinPath path;
-    for (Index i : read_pins(t, count, named, names)) {
-      for (const PinPath& other : scene.pin_paths) {
-        if (std::find(other.particles.begin(), other.particles.end(), first + i) ==
-            other.particles.end()) {
-          continue;
-        }
+    const std::vector<Index> pins = read_pins(t, scene, count, named, names);
+    const auto is_fixed = [&](Index i) { return fixed[static_cast<size_t>(i)]; };
+    if (const auto both = std::count_if(pins.begin(), pins.end(), is_fixed); both > 0) {
+      const auto k =
+          static_cast<size_t>(std::find_if(pins.begin(), pins.end(), is_fixed) - pins.begin());
+      t.warn(scene, "pins",
+             fmt::format("particle {} is pinned by the body's 'pins' and moved by {} ({} such "
+                         "particle{} in all); the path moves it, so its fixed pin does nothing: "
+                         "remove it from one of the two",
+                         pins[k], t.display_name(), both, both == 1 ? "" : "s"),
+             t.is_array("pins") ? std::optional<size_t>(k) : std::nullopt);
+    }
+    for (Index i : pins) {
+      if (on_path[static_cast<size_t>(i)]) {
         t.fail("pins", fmt::format("particle {} of {} is on an earlier path already; expected "
                                    "each particle on one path at most",
                                    i, t.display_name()));
@@ -222,6 +271,8 @@ void read_pin_paths(SceneTable& body, Scene& scene, Index first, Index count,
                                    t.display_name()));
       }
     }
+    for (Index i : pins)
+      on_path[static_cast<size_t>(i)] = true;
     scene.pin_paths.push_back(std::move(path));
   }
 }
@@ -280,7 +331,7 @@ void read_rope(SceneTable& t, Scene& scene) {
     if (name == "last" || name == "both") out.push_back(rope.count - 1);
     return name == "first" || name == "last" || name == "both" || name == "none";
   };
-  for (Index i : read_pins(t, rope.count, named, "first, last, both, none"))
+  for (Index i : read_pins(t, scene, rope.count, named, "first, last, both, none"))
     pin(p, rope.first + i);
   read_pin_paths(t, scene, rope.first, rope.count, named, "first, last, both, none");
   scene.rope = rope;
@@ -322,7 +373,7 @@ void read_cloth(SceneTable& t, Scene& scene) {
     return named_pins(grid, name, out);
   };
   for (Index i :
-       read_pins(t, grid.size(), named, "top-corners, corners, top-edge, left-edge, none")) {
+       read_pins(t, scene, grid.size(), named, "top-corners, corners, top-edge, left-edge, none")) {
     pin(p, grid.first + i);
   }
   read_pin_paths(t, scene, grid.first, grid.size(), named,
@@ -374,7 +425,7 @@ void read_solid(SceneTable& t, Scene& scene) {
   const auto named = [&](std::string_view name, std::vector<Index>& out) {
     return named_solid_pins(lattice, name, out);
   };
-  for (Index i : read_pins(t, lattice.size(), named, "top-face, bottom-face, none"))
+  for (Index i : read_pins(t, scene, lattice.size(), named, "top-face, bottom-face, none"))
     pin(p, lattice.first + i);
   read_pin_paths(t, scene, lattice.first, lattice.size(), named, "top-face, bottom-face, none");
   scene.solid = lattice;
@@ -397,6 +448,41 @@ void read_spring(SceneTable& t, Scene& scene) {
   const double kd = t.number("kd", Range::non_negative("N s/m"), 0.0);
   const double l0 = t.number("l0", Range::non_negative("m"), -1.0);  // default: distance now
   scene.springs.add(i, j, ks, kd, l0, p.x);
+  // The strain (l - l0) / l0 divides by l0: a spring of no rest length has none, and its force
+  // ks l pulls its ends onto each other.
+  if (scene.springs.l0(scene.springs.size() - 1) == 0.0) {
+    const std::string what =
+        t.has("l0") ? fmt::format("{} has l0 = 0", t.display_name())
+                    : fmt::format(
+                          "{} joins particles {} and {}, which start at the same "
+                          "position, so its rest length (the distance at the start) is 0",
+                          t.display_name(), i, j);
+    t.warn(scene, "l0",
+           fmt::format("{}: with no rest length its strain (l - l0) / l0 is undefined and it pulls "
+                       "its ends together until they meet; give l0 > 0 [m]{}",
+                       what,
+                       t.has("l0") ? " (or leave l0 out: the distance at the start)"
+                                   : " or move one of the particles"));
+  }
+}
+
+// Warns at 'ks' of [springs] or [bending] when springs `from` on include some of rest length 0:
+// their ends start at one point, where the body's spacing is too small to tell them apart
+// (1 + 1e-300 is 1).
+void warn_zero_rest_lengths(SceneTable& t, Scene& scene, const SpringSet& springs, size_t from) {
+  size_t zero = 0, first = 0;
+  for (size_t k = from; k < springs.size(); ++k) {
+    if (springs.l0(k) == 0.0 && zero++ == 0) first = k;
+  }
+  if (zero == 0) return;
+  t.warn(scene, "ks",
+         fmt::format("{} makes {} spring{} of rest length 0, the first from particle {} to {}: "
+                     "their ends start at the same position, so with no rest length their strain "
+                     "(l - l0) / l0 is undefined and they pull their ends together until they "
+                     "meet; give the body a spacing (or size) large enough to tell its particles "
+                     "apart where it is",
+                     t.display_name(), zero, zero == 1 ? "" : "s", springs.i(first),
+                     springs.j(first)));
 }
 
 // [springs]: structural and shear springs of the cloth, the rope's springs (lesson 02), the
@@ -412,6 +498,7 @@ void read_springs(SceneTable& t, Scene& scene) {
   const double shear_ks = t.number("shear_ks", Range::non_negative("N/m"), ks);
   const double shear_kd = t.number("shear_kd", Range::non_negative("N s/m"), kd);
   const Matrix3X& x = scene.world.particles.x;
+  const size_t from = scene.springs.size();  // after the [[spring]] tables' springs
   if (scene.rope)
     add_spring_family(scene.springs, rope_pairs(scene.rope->count), scene.rope->first, ks, kd, x);
   if (scene.cloth) {
@@ -429,6 +516,7 @@ void read_springs(SceneTable& t, Scene& scene) {
     add_spring_family(scene.springs, solid_body_diagonal_pairs(g.nx, g.ny, g.nz), g.first, shear_ks,
                       shear_kd, x);
   }
+  warn_zero_rest_lengths(t, scene, scene.springs, from);
 }
 
 // [bending]: flexion springs two apart, with their own constants (lesson 04).
@@ -444,6 +532,7 @@ void read_bending(SceneTable& t, Scene& scene) {
   if (scene.rope) {
     add_spring_family(bending, rope_bending_pairs(scene.rope->count), scene.rope->first, ks, kd, x);
   }
+  warn_zero_rest_lengths(t, scene, bending, 0);
   scene.world.force_effects.push_back(
       std::make_unique<SpringDampers>("bending", std::move(bending)));
 }
@@ -726,6 +815,17 @@ void read_integrator(SceneTable& t, Scene& scene) {
 // [output]: what a run writes.
 void read_output(SceneTable& t, Scene& scene) {
   scene.output.fps = t.number("fps", Range::positive("frames/s"), scene.output.fps);
+  // A run writes a frame every round(1 / (fps dt)) steps, at least one ([integrator], read
+  // before, gives dt): above 1/dt, fps asks for more frames than there are steps. The 1e-9
+  // keeps fps = 100 with dt = 0.01, whose product may round a hair above 1, quiet.
+  if (scene.output.fps * scene.dt > 1.0 + 1e-9) {
+    t.warn(scene, "fps",
+           fmt::format("fps = {} frames/s is more than the step rate 1/dt = {:.6g} steps/s: a "
+                       "frame is written every step, so the run writes {:.6g} frames per "
+                       "simulated second, not {}; take fps <= {:.6g} (or a smaller dt)",
+                       scene.output.fps, 1.0 / scene.dt, 1.0 / scene.dt, scene.output.fps,
+                       1.0 / scene.dt));
+  }
   scene.output.velocities = t.boolean("velocities", scene.output.velocities);
   scene.output.springs = t.boolean("springs", scene.output.springs);
 }
