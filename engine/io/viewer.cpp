@@ -1,8 +1,15 @@
 #include "io/viewer.hpp"
 
+#include <fcntl.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cerrno>
+#include <cstdio>
 #include <cstring>
-#include <fstream>
+#include <iterator>
 #include <stdexcept>
+#include <string_view>
 #include <utility>
 
 #include <fmt/format.h>
@@ -18,12 +25,10 @@ extern const std::string_view kViewerTemplate;  // viewer.html, embedded at buil
 
 namespace {
 
-std::string base64(const void* data, size_t size) {
+// Appends the base64 digits of `size` bytes to `out`.
+void append_base64(std::string& out, const unsigned char* bytes, size_t size) {
   static constexpr char kDigits[] =
       "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
-  const auto* bytes = static_cast<const unsigned char*>(data);
-  std::string out;
-  out.reserve((size + 2) / 3 * 4);
   for (size_t i = 0; i < size; i += 3) {
     // Three bytes make four 6-bit digits; a short last group is padded with '='.
     const unsigned a = bytes[i];
@@ -35,68 +40,206 @@ std::string base64(const void* data, size_t size) {
     out += i + 1 < size ? kDigits[(group >> 6) & 63] : '=';
     out += i + 2 < size ? kDigits[group & 63] : '=';
   }
-  return out;
+}
+
+// The page's file, written through a buffer of 1 MiB: the page streams out in large writes,
+// never held whole in memory, and every error carries the system's reason (errno).
+class PageFile {
+ public:
+  PageFile(const std::filesystem::path& path, const std::filesystem::path& page) : page_(page) {
+    fd_ = ::open(path.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0666);
+    if (fd_ < 0) fail(errno);
+    buffer_.reserve(kChunk + kChunk / 4);
+  }
+  ~PageFile() {
+    if (fd_ >= 0) ::close(fd_);
+  }
+  PageFile(const PageFile&) = delete;
+  PageFile& operator=(const PageFile&) = delete;
+
+  void put(std::string_view text) {
+    buffer_ += text;
+    if (buffer_.size() >= kChunk) drain();
+  }
+  void put(Index i) {
+    fmt::format_to(std::back_inserter(buffer_), "{}", i);
+    if (buffer_.size() >= kChunk) drain();
+  }
+  // Writes out what is buffered, then asks the system to put the file on disk before it is
+  // renamed into place: otherwise a power cut could leave the new name on a file not written.
+  void finish() {
+    drain();
+    if (::fsync(fd_) != 0 && errno != EINVAL) fail(errno);  // EINVAL: a file that cannot sync
+    const int fd = std::exchange(fd_, -1);
+    if (::close(fd) != 0) fail(errno);
+  }
+
+  static constexpr size_t kChunk = 1 << 20;  // [bytes]
+
+ private:
+  void drain() {
+    const char* data = buffer_.data();
+    size_t size = buffer_.size();
+    while (size > 0) {
+      const ssize_t n = ::write(fd_, data, size);
+      if (n < 0 && errno == EINTR) continue;
+      if (n < 0) fail(errno);
+      if (n == 0) fail(EIO);  // no byte taken and no reason given
+      data += n;
+      size -= static_cast<size_t>(n);
+    }
+    buffer_.clear();
+  }
+  [[noreturn]] void fail(int error) const {
+    throw std::runtime_error(
+        fmt::format("cannot write {}: {}", page_.string(), std::strerror(error)));
+  }
+
+  std::filesystem::path page_;  // the name the user knows, for messages
+  int fd_ = -1;
+  std::string buffer_;
+};
+
+// Puts the base64 of a frame's floats as a JSON string, a piece at a time.
+void put_frame(PageFile& file, const std::vector<float>& x, std::string& piece) {
+  const auto* bytes = reinterpret_cast<const unsigned char*>(x.data());
+  const size_t size = x.size() * sizeof(float);
+  constexpr size_t kPiece = 3 * (1 << 16);  // a multiple of 3: no padding but at the end
+  file.put("\"");
+  for (size_t at = 0; at < size; at += kPiece) {
+    piece.clear();
+    append_base64(piece, bytes + at, std::min(kPiece, size - at));
+    file.put(piece);
+  }
+  file.put("\"");
+}
+
+// "2nd", "3rd", "12th", "21st".
+std::string ordinal(long k) {
+  const long tens = k % 100, units = k % 10;
+  const char* suffix = (tens >= 11 && tens <= 13) ? "th"
+                       : units == 1               ? "st"
+                       : units == 2               ? "nd"
+                       : units == 3               ? "rd"
+                                                  : "th";
+  return fmt::format("{}{}", k, suffix);
+}
+
+// "256 MiB", "11.4 MiB", "12 KiB", "96 bytes".
+std::string bytes_text(long bytes) {
+  constexpr long kKiB = 1024, kMiB = 1024 * 1024;
+  if (bytes >= kMiB && bytes % kMiB == 0) return fmt::format("{} MiB", bytes / kMiB);
+  if (bytes >= kMiB) return fmt::format("{:.1f} MiB", static_cast<double>(bytes) / kMiB);
+  if (bytes >= kKiB) return fmt::format("{:.0f} KiB", static_cast<double>(bytes) / kKiB);
+  return fmt::format("{} bytes", bytes);
 }
 
 }  // namespace
 
 ViewerRecorder::ViewerRecorder(std::string title, std::string source, long expected_frames,
-                               long max_frames)
-    : title_(std::move(title)), source_(std::move(source)) {
-  stride_ = std::max(1L, (expected_frames + max_frames - 1) / max_frames);
-}
+                               long max_frames, long budget)
+    : title_(std::move(title)),
+      source_(std::move(source)),
+      expected_frames_(expected_frames),
+      max_frames_(max_frames),
+      budget_(budget) {}
 
 void ViewerRecorder::offer(const World& world) {
-  if (offered_++ % stride_ != 0) return;
   const Matrix3X& x = world.particles.x;
-  positions_.emplace_back(x.data(), x.data() + x.size());  // doubles -> floats
-  if (surfaces_.empty() || surfaces_.back().second.size() != world.triangles.size()) {
-    surfaces_.emplace_back(static_cast<long>(times_.size()), world.triangles);
+  if (offered_ == 0) {
+    // The page holds `limit_` frames: max_frames, fewer if they would pass the budget, and at
+    // least the first and the last. The last needs a place of its own unless every frame is
+    // kept, so the stride spreads the others over limit_ - 1 places.
+    const long frame_bytes = std::max<long>(1, x.size() * static_cast<long>(sizeof(float)));
+    limit_ = std::max(2L, std::min(max_frames_, budget_ / frame_bytes));
+    stride_ = expected_frames_ <= limit_
+                  ? 1
+                  : (expected_frames_ + (limit_ - 1) - 1) / (limit_ - 1);  // rounded up
   }
-  times_.push_back(world.t);
-  kinetic_.push_back(world.kinetic_energy());
-  potential_.push_back(world.potential_energy());
+  const long k = offered_++;
+  // A run that offers more frames than expected finds every place taken; the last frame needs a
+  // place of its own unless every frame is kept (a stride of 1).
+  const auto full = [&] {
+    return static_cast<long>(kept_.size()) >= (stride_ == 1 ? limit_ : limit_ - 1);
+  };
+  while (k % stride_ == 0 && full())
+    thin_out();
+  last_pending_ = k % stride_ != 0;
+  Frame& frame = last_pending_ ? last_ : kept_.emplace_back();
+  frame.x.assign(x.data(), x.data() + x.size());  // doubles -> floats
+  frame.t = world.t;
+  frame.kinetic = world.kinetic_energy();
+  frame.potential = world.potential_energy();
+  const bool differs =
+      surfaces_.empty() || surfaces_.back().second.size() != world.triangles.size();
+  if (!last_pending_ && differs) {
+    surfaces_.emplace_back(static_cast<long>(kept_.size()) - 1, world.triangles);
+  }
+  last_surface_differs_ = last_pending_ && differs;
+  if (last_surface_differs_) last_surface_ = world.triangles;
+}
+
+void ViewerRecorder::thin_out() {
+  // Kept frame j (offered frame j * stride) stays when j is even, as kept frame j / 2. A
+  // surface from kept frame j on is shown from the next one that stays, j / 2 rounded up; of
+  // two that land on the same frame the later one wins.
+  for (size_t j = 1; 2 * j < kept_.size(); ++j)
+    kept_[j] = std::move(kept_[2 * j]);
+  kept_.resize((kept_.size() + 1) / 2);
+  std::vector<std::pair<long, std::vector<Triangle>>> surfaces;
+  for (auto& [from, list] : surfaces_) {
+    const long to = (from + 1) / 2;
+    if (!surfaces.empty() && surfaces.back().first == to) surfaces.pop_back();
+    surfaces.emplace_back(to, std::move(list));
+  }
+  surfaces_ = std::move(surfaces);
+  stride_ *= 2;
+}
+
+long ViewerRecorder::frames_kept() const {
+  return static_cast<long>(kept_.size()) + (last_pending_ ? 1 : 0);
+}
+
+std::string ViewerRecorder::sampling_note() const {
+  if (frames_kept() == offered_) return "";
+  const long frame_bytes = static_cast<long>(kept_.front().x.size() * sizeof(float));
+  const std::string which = kept_.size() == 1 ? "the first frame"
+                            : stride_ == 2    ? "every other frame"
+                                              : "every " + ordinal(stride_) + " frame";
+  const std::string why = budget_ / std::max(1L, frame_bytes) < max_frames_
+                              ? fmt::format("a page holds at most {} of frames, {} each",
+                                            bytes_text(budget_), bytes_text(frame_bytes))
+                              : fmt::format("a page holds at most {} frames", max_frames_);
+  return fmt::format("the page keeps {} and the last ({} of {}): {}", which, frames_kept(),
+                     offered_, why);
 }
 
 void ViewerRecorder::write(const World& world, const std::filesystem::path& html) const {
+  // The frames of the page: those kept, then the last one offered if it is not among them.
+  std::vector<const Frame*> frames;
+  for (const Frame& frame : kept_)
+    frames.push_back(&frame);
+  if (last_pending_) frames.push_back(&last_);
+  std::vector<double> times, kinetic, potential, total;
+  for (const Frame* frame : frames) {
+    times.push_back(frame->t);
+    kinetic.push_back(frame->kinetic);
+    potential.push_back(frame->potential);
+    total.push_back(frame->kinetic + frame->potential);
+  }
+
+  // The small part of the data through the JSON library; the mesh and the frames, which may be
+  // hundreds of megabytes, are streamed to the file below, keys of the same object.
   using Json = nlohmann::ordered_json;  // keeps the keys in the order they are set
   Json data;
   data["title"] = title_;
   data["source"] = source_;
   data["particles"] = world.particles.size();
-  data["times"] = times_;
-  data["kinetic"] = kinetic_;
-  data["potential"] = potential_;
-  std::vector<double> total(kinetic_.size());
-  for (size_t k = 0; k < total.size(); ++k)
-    total[k] = kinetic_[k] + potential_[k];
+  data["sampling"] = sampling_note();
+  data["times"] = times;
+  data["kinetic"] = kinetic;
+  data["potential"] = potential;
   data["total"] = total;
-  // Each surface as {"from": first frame, "triangles": [i, j, k, ...]}.
-  data["surfaces"] = Json::array();
-  for (const auto& [from, list] : surfaces_) {
-    std::vector<Index> flat;
-    for (const Triangle& t : list)
-      flat.insert(flat.end(), t.begin(), t.end());
-    Json surface;
-    surface["from"] = from;
-    surface["triangles"] = flat;
-    data["surfaces"].push_back(std::move(surface));
-  }
-  std::vector<Index> springs;
-  for (const auto& effect : world.force_effects) {
-    if (const auto* s = dynamic_cast<const SpringDampers*>(effect.get())) {
-      for (size_t k = 0; k < s->springs().size(); ++k) {
-        springs.push_back(s->springs().i(k));
-        springs.push_back(s->springs().j(k));
-      }
-    }
-  }
-  data["springs"] = springs;
-  std::vector<Index> pins;
-  for (Index i = 0; i < world.particles.size(); ++i) {
-    if (world.particles.inv_m[i] == 0.0) pins.push_back(i);
-  }
-  data["pins"] = pins;
   // Colliders, drawn so that a student sees what the cloth lies on.
   data["colliders"] = Json::array();
   for (const auto& effect : world.post_step_effects) {
@@ -117,21 +260,88 @@ void ViewerRecorder::write(const World& world, const std::filesystem::path& html
     }
     data["colliders"].push_back(std::move(collider));
   }
-  data["frames"] = Json::array();
-  for (const std::vector<float>& frame : positions_)
-    data["frames"].push_back(base64(frame.data(), frame.size() * sizeof(float)));
   // A title or file name that is not valid UTF-8 gets U+FFFD where it is not, rather than no
-  // page; "</" is escaped so that no string closes the page's <script> element.
-  const std::string json =
-      script_safe_json(data.dump(-1, ' ', false, Json::error_handler_t::replace));
+  // page; every <, > and & is escaped so that no string closes the page's <script> element.
+  // The streamed part is numbers and base64 digits, which hold none of the three.
+  std::string head = script_safe_json(data.dump(-1, ' ', false, Json::error_handler_t::replace));
+  head.pop_back();  // the closing '}': the object goes on below
 
   const std::string_view marker = "/*CLOTHLAB_DATA*/";
   const size_t at = kViewerTemplate.find(marker);
   if (at == std::string_view::npos) throw std::logic_error("viewer.html has no data marker");
-  std::ofstream out(html, std::ios::binary | std::ios::trunc);
-  if (!out) throw std::runtime_error(fmt::format("cannot write {}", html.string()));
-  out << kViewerTemplate.substr(0, at) << json << kViewerTemplate.substr(at + marker.size());
-  if (!out) throw std::runtime_error(fmt::format("writing {} failed", html.string()));
+
+  // The page goes to a temporary name in the same folder (a rename does not cross file
+  // systems), then over `html` in one step.
+  std::filesystem::path temporary = html;
+  temporary.replace_filename(fmt::format(".{}.{}.partial", html.filename().string(), ::getpid()));
+  try {
+    PageFile file(temporary, html);
+    file.put(kViewerTemplate.substr(0, at));
+    file.put(head);
+    // Each surface as {"from": first frame, "triangles": [i, j, k, ...]}, the last frame's
+    // after those of the kept frames when it differs from them.
+    std::vector<std::pair<long, const std::vector<Triangle>*>> surfaces;
+    for (const auto& [from, list] : surfaces_)
+      surfaces.emplace_back(from, &list);
+    if (last_surface_differs_) {
+      surfaces.emplace_back(static_cast<long>(frames.size()) - 1, &last_surface_);
+    }
+    file.put(",\"surfaces\":[");
+    for (size_t k = 0; k < surfaces.size(); ++k) {
+      file.put(k == 0 ? "{\"from\":" : ",{\"from\":");
+      file.put(static_cast<Index>(surfaces[k].first));
+      file.put(",\"triangles\":[");
+      bool first = true;
+      for (const Triangle& t : *surfaces[k].second) {
+        for (const Index i : t) {
+          if (!first) file.put(",");
+          first = false;
+          file.put(i);
+        }
+      }
+      file.put("]}");
+    }
+    file.put("]");
+    file.put(",\"springs\":[");
+    bool first = true;
+    for (const auto& effect : world.force_effects) {
+      if (const auto* s = dynamic_cast<const SpringDampers*>(effect.get())) {
+        for (size_t k = 0; k < s->springs().size(); ++k) {
+          if (!first) file.put(",");
+          first = false;
+          file.put(s->springs().i(k));
+          file.put(",");
+          file.put(s->springs().j(k));
+        }
+      }
+    }
+    file.put("],\"pins\":[");
+    first = true;
+    for (Index i = 0; i < world.particles.size(); ++i) {
+      if (world.particles.inv_m[i] != 0.0) continue;
+      if (!first) file.put(",");
+      first = false;
+      file.put(i);
+    }
+    file.put("],\"frames\":[");
+    std::string piece;
+    for (size_t f = 0; f < frames.size(); ++f) {
+      if (f > 0) file.put(",");
+      put_frame(file, frames[f]->x, piece);
+    }
+    file.put("]}");
+    file.put(kViewerTemplate.substr(at + marker.size()));
+    file.finish();
+    std::error_code error;
+    std::filesystem::rename(temporary, html, error);
+    if (error) {
+      throw std::runtime_error(fmt::format("cannot write {}: {}", html.string(), error.message()));
+    }
+  } catch (...) {
+    std::error_code ignored;  // the first error is the one to report
+    std::filesystem::remove(temporary, ignored);
+    throw;
+  }
 }
 
 }  // namespace clothlab
