@@ -186,6 +186,10 @@ int run(Scene& scene, const RunOutputs& outputs, bool stats) {
     fmt::print("\n");
     if (!outputs.html.empty()) {
       fmt::print("  watch it: open {} in a browser\n", outputs.html.string());
+      if (!report.page_note.empty()) {
+        fmt::print("  {}; the {} files have every frame\n", report.page_note,
+                   outputs.npy || scene.output.npy ? "data" : "CSV");
+      }
     }
     if (stats) print_stats(scene.world, times);
     warn_unconverged(scene.world);
@@ -241,6 +245,12 @@ int main(int argc, char** argv) {
   bool no_html = false, obj = false, vtk = false, stats = false;
   run_cmd->add_option("--html", html, "Viewer page to write (default: <output folder>/view.html)");
   run_cmd->add_flag("--no-html", no_html, "Write no viewer page");
+  std::string format = "csv";
+  run_cmd
+      ->add_option("--format", format,
+                   "csv: positions.csv (every bit of each double); npy: positions.npy, 32-bit "
+                   "floats, a fifth of the size, for big runs (as [output] format)")
+      ->check(CLI::IsMember({"csv", "npy"}));
   bool force = false;
   run_cmd->add_flag("--force", force,
                     "Write into an output folder that is not clothlab's (files named as its "
@@ -294,6 +304,7 @@ int main(int argc, char** argv) {
       outputs.springs = springs;
       // A default folder, clothlab-out/<scene>, holding only what a run writes is taken as
       // clothlab's even without a marker: it is what a version before the marker left.
+      outputs.npy = format == "npy";
       outputs.force = force || (out_dir.empty() && holds_only_run_outputs(outputs.dir));
       if (threads >= 0)
         scene.world.threads = threads > 0 ? threads : ThreadTeam::hardware_threads();

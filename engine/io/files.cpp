@@ -110,10 +110,12 @@ void ReplaceFile::write(std::string_view bytes) {
   }
 }
 
-void ReplaceFile::commit() {
+void ReplaceFile::commit(bool sync) {
   if (fd_ < 0) throw std::logic_error("ReplaceFile::commit twice");
   const int fd = std::exchange(fd_, -1);
-  int error = ::close(fd) == 0 ? 0 : errno;
+  int error = 0;
+  if (sync && ::fsync(fd) != 0 && errno != EINVAL) error = errno;  // EINVAL: cannot sync (a pipe)
+  if (::close(fd) != 0 && error == 0) error = errno;
   if (error == 0 && ::rename(temporary_.c_str(), path_.c_str()) != 0) error = errno;
   if (error != 0) {
     ::unlink(temporary_.c_str());

@@ -68,8 +68,10 @@ class ReplaceFile {
   ~ReplaceFile();  // without commit(): removes the temporary file, leaves `path` as it was
 
   void write(std::string_view bytes);
-  // Puts the file in place of `path`.
-  void commit();
+  // Puts the file in place of `path`; with `sync`, only once the system has it on disk (so that
+  // a power cut cannot leave the name on a file not written: worth it for a big page, not for
+  // each small mesh frame).
+  void commit(bool sync = false);
 
  private:
   std::filesystem::path path_, temporary_;

@@ -1,6 +1,7 @@
 #include "io/npy.hpp"
 
 #include <fcntl.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <bit>
@@ -11,6 +12,8 @@
 #include <vector>
 
 #include <fmt/format.h>
+
+#include "io/files.hpp"
 
 namespace clothlab {
 
@@ -104,8 +107,7 @@ void NpyFrameWriter::append(const Matrix3X& x) {
     const std::string head = header(frames_, particles_);
     write_all_at(fd_, head.data(), head.size(), 0);
     [[maybe_unused]] const int cut = ::ftruncate(fd_, whole);  // a device has nothing to cut
-    throw std::runtime_error(
-        fmt::format("cannot write {}: {}", path_.string(), std::strerror(error)));
+    throw OutputError(fmt::format("cannot write {}: {}", path_.string(), std::strerror(error)));
   };
   // The frame first, then the count that takes it in: never a count without its frame. Each
   // pwrite hands the bytes to the system at once (no buffer here), so a stopped program leaves
@@ -117,6 +119,17 @@ void NpyFrameWriter::append(const Matrix3X& x) {
   const std::string head = header(frames_ + 1, particles_);
   if (const int error = write_all_at(fd_, head.data(), head.size(), 0)) fail(error);
   ++frames_;
+}
+
+bool NpyFrameWriter::cut_back(long frames) noexcept {
+  if (fd_ < 0 || frames < 0 || frames > frames_) return false;
+  const off_t bytes = static_cast<off_t>(particles_) * 3 * static_cast<off_t>(sizeof(float));
+  const std::string head = header(frames, particles_);
+  if (write_all_at(fd_, head.data(), head.size(), 0) != 0) return false;
+  frames_ = frames;
+  struct stat status {};
+  if (::fstat(fd_, &status) == 0 && !S_ISREG(status.st_mode)) return true;  // a device
+  return ::ftruncate(fd_, kHeaderBytes + static_cast<off_t>(frames) * bytes) == 0;
 }
 
 }  // namespace clothlab

@@ -34,6 +34,10 @@ class NpyFrameWriter {
   // Appends `x` (3 x N, one particle per column, N as constructed) as the next frame.
   void append(const Matrix3X& x);
 
+  // Cuts the file back to its first `frames` frames (no more than it has), e.g. to take back a
+  // frame another file could not take. Best effort: returns whether it worked.
+  bool cut_back(long frames) noexcept;
+
   long frames() const { return frames_; }
   const std::filesystem::path& path() const { return path_; }
 

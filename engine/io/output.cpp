@@ -11,13 +11,23 @@
 
 namespace clothlab {
 
-FrameWriter::FrameWriter(const std::filesystem::path& dir, bool velocities, bool springs) {
-  files_ = {dir / "energy.csv", dir / "positions.csv"};
+FrameWriter::FrameWriter(const std::filesystem::path& dir, bool velocities, bool springs, bool npy,
+                         Index particles) {
+  files_ = {dir / "energy.csv"};
   energy_ = AppendFile(files_[0]);
-  positions_ = AppendFile(files_[1]);
   energy_.append("frame,t,kinetic,potential,total,px,py,pz\n");
-  positions_.append("frame,t,particle,x,y,z\n");
-  if (velocities) {
+  if (npy) {
+    files_.push_back(dir / "positions.npy");
+    positions_npy_.emplace(files_.back(), particles);
+  } else {
+    files_.push_back(dir / "positions.csv");
+    positions_ = AppendFile(files_.back());
+    positions_.append("frame,t,particle,x,y,z\n");
+  }
+  if (velocities && npy) {
+    files_.push_back(dir / "velocities.npy");
+    velocities_npy_.emplace(files_.back(), particles);
+  } else if (velocities) {
     files_.push_back(dir / "velocities.csv");
     velocities_ = AppendFile(files_.back());
     velocities_.append("frame,t,particle,vx,vy,vz\n");
@@ -117,8 +127,11 @@ void FrameWriter::write(const World& world, long frame, long step) {
   off_t sizes[std::size(files)];
   for (size_t k = 0; k < std::size(files); ++k)
     sizes[k] = files[k]->size();
+  const long npy_frames = positions_npy_ ? positions_npy_->frames() : 0;
   try {
-    positions_.append(particle_rows(world.particles.x, frame, world.t));
+    if (positions_npy_) positions_npy_->append(world.particles.x);
+    if (velocities_npy_) velocities_npy_->append(world.particles.v);
+    if (positions_.is_open()) positions_.append(particle_rows(world.particles.x, frame, world.t));
     if (velocities_.is_open()) velocities_.append(particle_rows(world.particles.v, frame, world.t));
     if (springs_.is_open()) springs_.append(springs);
     energy_.append(fmt::format("{},{:.17g},{:.17g},{:.17g},{:.17g},{:.17g},{:.17g},{:.17g}\n",
@@ -127,6 +140,8 @@ void FrameWriter::write(const World& world, long frame, long step) {
   } catch (const OutputError&) {
     for (size_t k = 0; k < std::size(files); ++k)
       files[k]->cut_back(sizes[k]);
+    if (positions_npy_) positions_npy_->cut_back(npy_frames);
+    if (velocities_npy_) velocities_npy_->cut_back(npy_frames);
     throw;
   }
 }

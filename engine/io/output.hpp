@@ -4,6 +4,9 @@
 //   positions.csv  frame, t [s], particle, x, y, z [m]  (a point cloud per frame; ParaView
 //                  reads it with "Table To Points", a spreadsheet or pandas reads it as is)
 // and, when asked for:
+//   positions.npy  in place of positions.csv (`--format npy`, [output] format = "npy"): the
+//                  positions as 32-bit floats, shape (frames, N, 3), a fifth of the CSV's size
+//                  and read in one call (io/npy.hpp); with velocities, velocities.npy too
 //   velocities.csv frame, t [s], particle, vx, vy, vz [m/s]  (the same rows as positions.csv)
 //   springs.csv    frame, t [s], effect, spring, i, j, strain, tension [N]  for each spring of
 //                  each spring effect ("springs", "bending"): strain = (l - l0) / l0 (empty for
@@ -17,19 +20,22 @@
 #pragma once
 
 #include <filesystem>
+#include <optional>
 #include <vector>
 
 #include "clothlab/core/world.hpp"
 #include "io/files.hpp"
+#include "io/npy.hpp"
 
 namespace clothlab {
 
 class FrameWriter {
  public:
   // Opens the files in `dir` (which must exist), replacing those of an earlier run; with
-  // `velocities` and `springs`, velocities.csv and springs.csv as well.
+  // `velocities` and `springs`, velocities.csv and springs.csv as well; with `npy`, the
+  // positions (and velocities) of `particles` particles as .npy files instead of CSV.
   explicit FrameWriter(const std::filesystem::path& dir, bool velocities = false,
-                       bool springs = false);
+                       bool springs = false, bool npy = false, Index particles = 0);
 
   // Appends frame number `frame` of the world's current state, after step `step`, to every
   // file. Throws SimulationError, before writing, if a value of the frame is not finite; throws
@@ -41,8 +47,9 @@ class FrameWriter {
  private:
   AppendFile energy_;
   AppendFile positions_;
-  AppendFile velocities_;  // open only when asked for
-  AppendFile springs_;     // open only when asked for
+  AppendFile velocities_;                                         // open only when asked for
+  AppendFile springs_;                                            // open only when asked for
+  std::optional<NpyFrameWriter> positions_npy_, velocities_npy_;  // in place of the CSV files
   std::vector<std::filesystem::path> files_;
 };
 

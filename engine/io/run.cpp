@@ -88,7 +88,8 @@ RunReport run_scene(Scene& scene, const RunOutputs& outputs, const ProgressFn& p
   RunFolder folder(outputs.dir, outputs.force);
   if (page_inside) check_page_target(outputs.html, outputs.force);
   FrameWriter writer(outputs.dir, outputs.velocities || scene.output.velocities,
-                     outputs.springs || scene.output.springs);
+                     outputs.springs || scene.output.springs, outputs.npy || scene.output.npy,
+                     scene.world.particles.size());
   MeshExporter meshes(outputs.dir / "frames", outputs.obj, outputs.vtk);
   RunReport report;
   report.files = writer.files();
@@ -96,7 +97,9 @@ RunReport run_scene(Scene& scene, const RunOutputs& outputs, const ProgressFn& p
   const long total = scene.step_count();
   // A frame every 1/fps seconds: that many steps, rounded, and at least one.
   const long steps_per_frame = std::max(1L, std::lround(1.0 / (scene.output.fps * scene.dt)));
-  ViewerRecorder viewer(scene.title, scene.source, total / steps_per_frame + 2);
+  // The first frame, one every steps_per_frame steps, and the last if it falls between.
+  const long frames = 1 + total / steps_per_frame + (total % steps_per_frame != 0 ? 1 : 0);
+  ViewerRecorder viewer(scene.title, scene.source, frames);
 
   World& world = scene.world;
   long step = 0;
@@ -154,6 +157,7 @@ RunReport run_scene(Scene& scene, const RunOutputs& outputs, const ProgressFn& p
   if (page) {
     write_page();
     report.files.push_back(outputs.html);
+    report.page_note = viewer.sampling_note();
   }
   if (outputs.obj || outputs.vtk) report.files.push_back(outputs.dir / "frames");
   return report;

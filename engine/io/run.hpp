@@ -4,6 +4,7 @@
 #include <filesystem>
 #include <functional>
 #include <stdexcept>
+#include <string>
 #include <vector>
 
 #include "scene/scene.hpp"
@@ -18,6 +19,7 @@ struct RunOutputs {
   bool vtk = false;            // a VTK series in dir/frames/
   bool velocities = false;     // velocities.csv, even if the scene's [output] does not ask
   bool springs = false;        // springs.csv, even if the scene's [output] does not ask
+  bool npy = false;            // positions.npy in place of positions.csv, as [output] format
   bool force = false;  // write into a folder that is not clothlab's, or over a page that is not
                        // (io/run_folder.hpp)
 
@@ -29,6 +31,7 @@ struct RunReport {
   long steps = 0;             // steps taken
   long frames = 0;            // frames written
   double wall_seconds = 0.0;  // wall-clock time of the stepping loop [s]
+  std::string page_note;      // what the page kept of the frames, when not all (empty: all)
   std::vector<std::filesystem::path> files;
 };
 

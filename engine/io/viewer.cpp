@@ -1,8 +1,5 @@
 #include "io/viewer.hpp"
 
-#include <fcntl.h>
-#include <unistd.h>
-
 #include <algorithm>
 #include <cerrno>
 #include <cstdio>
@@ -17,6 +14,7 @@
 
 #include "clothlab/after_step/ground_collision.hpp"
 #include "clothlab/forces/spring_damper.hpp"
+#include "io/files.hpp"
 #include "io/json.hpp"
 
 namespace clothlab {
@@ -43,19 +41,13 @@ void append_base64(std::string& out, const unsigned char* bytes, size_t size) {
 }
 
 // The page's file, written through a buffer of 1 MiB: the page streams out in large writes,
-// never held whole in memory, and every error carries the system's reason (errno).
+// never held whole in memory, to a temporary file that replaces the page only when whole
+// (io/files.hpp).
 class PageFile {
  public:
-  PageFile(const std::filesystem::path& path, const std::filesystem::path& page) : page_(page) {
-    fd_ = ::open(path.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0666);
-    if (fd_ < 0) fail(errno);
+  explicit PageFile(const std::filesystem::path& page) : file_(page) {
     buffer_.reserve(kChunk + kChunk / 4);
   }
-  ~PageFile() {
-    if (fd_ >= 0) ::close(fd_);
-  }
-  PageFile(const PageFile&) = delete;
-  PageFile& operator=(const PageFile&) = delete;
 
   void put(std::string_view text) {
     buffer_ += text;
@@ -65,38 +57,21 @@ class PageFile {
     fmt::format_to(std::back_inserter(buffer_), "{}", i);
     if (buffer_.size() >= kChunk) drain();
   }
-  // Writes out what is buffered, then asks the system to put the file on disk before it is
-  // renamed into place: otherwise a power cut could leave the new name on a file not written.
+  // Writes out what is buffered and puts the page in place, on disk before it has the name.
   void finish() {
     drain();
-    if (::fsync(fd_) != 0 && errno != EINVAL) fail(errno);  // EINVAL: a file that cannot sync
-    const int fd = std::exchange(fd_, -1);
-    if (::close(fd) != 0) fail(errno);
+    file_.commit(/*sync=*/true);
   }
 
   static constexpr size_t kChunk = 1 << 20;  // [bytes]
 
  private:
   void drain() {
-    const char* data = buffer_.data();
-    size_t size = buffer_.size();
-    while (size > 0) {
-      const ssize_t n = ::write(fd_, data, size);
-      if (n < 0 && errno == EINTR) continue;
-      if (n < 0) fail(errno);
-      if (n == 0) fail(EIO);  // no byte taken and no reason given
-      data += n;
-      size -= static_cast<size_t>(n);
-    }
+    file_.write(buffer_);
     buffer_.clear();
   }
-  [[noreturn]] void fail(int error) const {
-    throw std::runtime_error(
-        fmt::format("cannot write {}: {}", page_.string(), std::strerror(error)));
-  }
 
-  std::filesystem::path page_;  // the name the user knows, for messages
-  int fd_ = -1;
+  ReplaceFile file_;
   std::string buffer_;
 };
 
@@ -270,12 +245,8 @@ void ViewerRecorder::write(const World& world, const std::filesystem::path& html
   const size_t at = kViewerTemplate.find(marker);
   if (at == std::string_view::npos) throw std::logic_error("viewer.html has no data marker");
 
-  // The page goes to a temporary name in the same folder (a rename does not cross file
-  // systems), then over `html` in one step.
-  std::filesystem::path temporary = html;
-  temporary.replace_filename(fmt::format(".{}.{}.partial", html.filename().string(), ::getpid()));
-  try {
-    PageFile file(temporary, html);
+  {
+    PageFile file(html);
     file.put(kViewerTemplate.substr(0, at));
     file.put(head);
     // Each surface as {"from": first frame, "triangles": [i, j, k, ...]}, the last frame's
@@ -332,15 +303,6 @@ void ViewerRecorder::write(const World& world, const std::filesystem::path& html
     file.put("]}");
     file.put(kViewerTemplate.substr(at + marker.size()));
     file.finish();
-    std::error_code error;
-    std::filesystem::rename(temporary, html, error);
-    if (error) {
-      throw std::runtime_error(fmt::format("cannot write {}: {}", html.string(), error.message()));
-    }
-  } catch (...) {
-    std::error_code ignored;  // the first error is the one to report
-    std::filesystem::remove(temporary, ignored);
-    throw;
   }
 }
 

@@ -53,6 +53,7 @@ struct OutputSettings {
   double fps = 30.0;        // frames written per simulated second [1/s]
   bool velocities = false;  // also velocities.csv: each particle's velocity, every frame
   bool springs = false;     // also springs.csv: each spring's strain and tension, every frame
+  bool npy = false;  // format = "npy": positions.npy (and velocities.npy) in place of the CSV
 };
 
 struct Scene {

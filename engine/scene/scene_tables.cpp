@@ -828,6 +828,7 @@ void read_output(SceneTable& t, Scene& scene) {
   }
   scene.output.velocities = t.boolean("velocities", scene.output.velocities);
   scene.output.springs = t.boolean("springs", scene.output.springs);
+  scene.output.npy = t.choice("format", {"csv", "npy"}, "csv") == "npy";
 }
 
 // [guard]: the bounds beyond which a run is stopped as blown up.
@@ -893,7 +894,7 @@ constexpr std::array kKinds = {
                    read_tearing},
     SceneTableKind{"integrator", false, true, "method dt duration tolerance max_iterations",
                    "[integrator] with method, dt [s] and duration [s]", read_integrator},
-    SceneTableKind{"output", false, false, "fps velocities springs", "[output] with fps",
+    SceneTableKind{"output", false, false, "fps velocities springs format", "[output] with fps",
                    read_output},
     SceneTableKind{"engine", false, false, "threads fast_path", "[engine] with threads",
                    read_engine},

@@ -4,6 +4,7 @@
 #include <sys/resource.h>
 
 #include <csignal>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
@@ -325,4 +326,23 @@ fps = 100
   const std::string page = read_all(dir / "view.html");
   CHECK(page.find("inf") == std::string::npos);
   CHECK(page.find("nan") == std::string::npos);
+}
+
+TEST_CASE("outputs: format npy writes positions.npy in place of positions.csv, frame for frame") {
+  const fs::path dir = fresh_dir("npy");
+  std::string text = kCloth;
+  text += "velocities = true\nformat = \"npy\"\n";  // in [output], the last table
+  clothlab::Scene scene = clothlab::parse_scene(text, "<cloth>");
+  const clothlab::RunReport report = clothlab::run_scene(scene, dir);
+  CHECK(report.frames == 21);
+  CHECK(names_in(dir) == std::vector<std::string>{".clothlab-run", "energy.csv", "positions.npy",
+                                                  "velocities.npy", "view.html"});
+  const std::string npy = read_all(dir / "positions.npy");
+  CHECK(npy.find("'shape': (21, 400, 3)") != std::string::npos);
+  CHECK(npy.size() == 128 + 21 * 400 * 3 * 4);
+  // The last frame's first particle, as the float the double was rounded to.
+  float x0 = 0;
+  std::memcpy(&x0, npy.data() + 128 + 20 * 400 * 3 * 4, sizeof x0);
+  CHECK(x0 == static_cast<float>(scene.world.particles.x(0, 0)));
+  CHECK(read_all(dir / "velocities.npy").size() == npy.size());
 }

@@ -219,7 +219,8 @@ TEST_CASE("viewer: the page replaces the old one whole, and a failed write leave
     }
     setrlimit(RLIMIT_FSIZE, &before);
     std::signal(SIGXFSZ, handler);
-    CHECK(error == "cannot write " + page.string() + ": " + std::string(strerror(EFBIG)));
+    CHECK(error == "writing " + page.string() + " failed: " + std::string(strerror(EFBIG)) +
+                       "; the file there is as it was");
     CHECK(read_text(page) == whole);  // the old page, whole
     CHECK(files_in(dir) == std::vector<std::string>{"view.html"});
   }
