@@ -28,6 +28,7 @@ void Xpbd::advance(World& world, double dt) {
   for (int s = 0; s < substeps; ++s) {
     // External forces at the substep's start (gravity, wind, drag, a game's push, ...).
     f_ext_.setZero();
+    ++world.force_evaluations;  // one sum of the external forces a substep (reports)
     for (const auto& effect : world.force_effects) {
       if (!dynamic_cast<const SpringDampers*>(effect.get()))
         effect->add_forces(p, p.x, p.v, f_ext_);
