@@ -24,6 +24,7 @@ PICTURES = {
     "09-ropes-and-solids": ("jelly-cube.toml", 21),
     "10-collision-detection": ("towel-on-a-line.toml", 50),
     "11-game-loop": ("banner.toml", 240),
+    "12-xpbd": ("stiff-curtain.toml", 120),
 }
 
 

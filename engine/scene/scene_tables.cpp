@@ -21,6 +21,7 @@
 #include "clothlab/forces/gravitation.hpp"
 #include "clothlab/forces/gravity.hpp"
 #include "clothlab/integrators/implicit_euler.hpp"
+#include "clothlab/integrators/xpbd.hpp"
 
 namespace clothlab {
 
@@ -782,9 +783,21 @@ void read_tearing(SceneTable& t, Scene& scene) {
 
 // [integrator]: the method, the time step and how long to simulate.
 void read_integrator(SceneTable& t, Scene& scene) {
-  const std::vector<std::string_view> names(integrator_names().begin(), integrator_names().end());
+  const std::vector<std::string_view> names(method_names().begin(), method_names().end());
   const std::string method = t.choice("method", names, "symplectic-euler");
   scene.world.integrator = make_integrator(method);
+  // The substeps and projections of the position-based method; the force-based ones have none.
+  for (const char* key : {"substeps", "iterations"}) {
+    if (method != "xpbd" && t.has(key)) {
+      t.fail(key, fmt::format("{} sets the position-based method = \"xpbd\" (lesson 12), but "
+                              "method is \"{}\"; expected no {} here",
+                              key, method, key));
+    }
+  }
+  if (auto* xpbd = dynamic_cast<Xpbd*>(scene.world.integrator.get())) {
+    xpbd->substeps = static_cast<int>(t.integer("substeps", 1, 100'000, xpbd->substeps));
+    xpbd->iterations = static_cast<int>(t.integer("iterations", 1, 10'000, xpbd->iterations));
+  }
   // The linear solver of the implicit method; another method has none to tune.
   for (const char* key : {"tolerance", "max_iterations"}) {
     if (method != "implicit-euler" && t.has(key)) {
@@ -892,7 +905,8 @@ constexpr std::array kKinds = {
                    "[plasticity] with yield_strain", read_plasticity},
     SceneTableKind{"tearing", false, false, "strain max_per_step", "[tearing] with strain",
                    read_tearing},
-    SceneTableKind{"integrator", false, true, "method dt duration tolerance max_iterations",
+    SceneTableKind{"integrator", false, true,
+                   "method dt duration tolerance max_iterations substeps iterations",
                    "[integrator] with method, dt [s] and duration [s]", read_integrator},
     SceneTableKind{"output", false, false, "fps velocities springs format", "[output] with fps",
                    read_output},

@@ -222,6 +222,15 @@ TEST_CASE("scene error: a solver tolerance for an explicit method") {
 TEST_CASE("scene error: a solver iteration limit for the default method") {
   check_bad_scene("max_iterations_without_implicit.toml");
 }
+TEST_CASE("scene error: substeps for a method other than xpbd") {
+  check_bad_scene("substeps_without_xpbd.toml");
+}
+TEST_CASE("scene error: projection iterations for a method other than xpbd") {
+  check_bad_scene("iterations_without_xpbd.toml");
+}
+TEST_CASE("scene error: xpbd with 0 substeps") {
+  check_bad_scene("zero_substeps.toml");
+}
 
 // Not finite, or overflowing.
 TEST_CASE("scene error: a mass of nan") {
@@ -407,7 +416,7 @@ TEST_CASE("scene error: every bad scene file has a test case") {
   for (const auto& entry : fs::directory_iterator(fs::path(CLOTHLAB_TEST_SCENES) / "bad")) {
     if (entry.path().extension() == ".toml") ++files;
   }
-  CHECK(files == 110);
+  CHECK(files == 113);
 }
 
 TEST_CASE("scene error: a missing file") {

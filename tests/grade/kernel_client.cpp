@@ -351,4 +351,10 @@ Substeps accumulate(double leftover, double frame_time, double dt, long max_subs
   return call(CLOTHLAB_KERNEL(accumulate), leftover, frame_time, dt, max_substeps);
 }
 
+double xpbd_distance_projection(Vec3& x_i, Vec3& x_j, double w_i, double w_j, double l0,
+                                double alpha_tilde, double lambda) {
+  return call(CLOTHLAB_KERNEL(xpbd_distance_projection), x_i, x_j, w_i, w_j, l0, alpha_tilde,
+              lambda);
+}
+
 }  // namespace clothlab

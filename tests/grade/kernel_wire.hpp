@@ -60,6 +60,7 @@
 #include "clothlab/integrators/euler.hpp"
 #include "clothlab/integrators/runge_kutta.hpp"
 #include "clothlab/integrators/stability_limit.hpp"
+#include "clothlab/integrators/xpbd.hpp"
 
 namespace clothlab::wire {
 
@@ -86,7 +87,8 @@ namespace clothlab::wire {
   X(cell_of)                          \
   X(cell_hash)                        \
   X(pair_response)                    \
-  X(accumulate)
+  X(accumulate)                       \
+  X(xpbd_distance_projection)
 
 #define CLOTHLAB_KERNEL_ENUM(name) name,
 enum class Kernel : std::uint32_t { CLOTHLAB_EXERCISE_KERNELS(CLOTHLAB_KERNEL_ENUM) count };

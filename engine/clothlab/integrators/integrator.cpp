@@ -6,6 +6,7 @@
 #include "clothlab/integrators/implicit_euler.hpp"
 #include "clothlab/integrators/runge_kutta.hpp"
 #include "clothlab/integrators/verlet.hpp"
+#include "clothlab/integrators/xpbd.hpp"
 
 namespace clothlab {
 
@@ -14,10 +15,18 @@ namespace {
 constexpr std::array<std::string_view, 7> kNames = {
     "explicit-euler",  "symplectic-euler", "midpoint",      "rk4",
     "velocity-verlet", "position-verlet",  "implicit-euler"};
+// The same and lesson 12's.
+constexpr std::array<std::string_view, 8> kMethods = {
+    "explicit-euler",  "symplectic-euler", "midpoint",       "rk4",
+    "velocity-verlet", "position-verlet",  "implicit-euler", "xpbd"};
 }  // namespace
 
 std::span<const std::string_view> integrator_names() {
   return kNames;
+}
+
+std::span<const std::string_view> method_names() {
+  return kMethods;
 }
 
 std::unique_ptr<Integrator> make_integrator(std::string_view name) {
@@ -28,6 +37,7 @@ std::unique_ptr<Integrator> make_integrator(std::string_view name) {
   if (name == "velocity-verlet") return std::make_unique<VelocityVerlet>();
   if (name == "position-verlet") return std::make_unique<PositionVerlet>();
   if (name == "implicit-euler") return std::make_unique<ImplicitEuler>();
+  if (name == "xpbd") return std::make_unique<Xpbd>();
   return nullptr;
 }
 

@@ -28,8 +28,13 @@ class Integrator {
   virtual int force_evaluations_per_step() const = 0;
 };
 
-// The names a scene may give in [integrator] method = "...".
+// The force-based integrators of lessons 01 to 08, which lesson 07 compares: what a scene may
+// give in [integrator] method = "...", but for the methods of method_names() alone.
 std::span<const std::string_view> integrator_names();
+
+// Every name a scene may give in [integrator] method = "...": integrator_names() and lesson 12's
+// position-based "xpbd", which moves particles by constraints instead of by spring forces.
+std::span<const std::string_view> method_names();
 
 // The integrator called `name`, or nullptr when there is none by that name.
 std::unique_ptr<Integrator> make_integrator(std::string_view name);

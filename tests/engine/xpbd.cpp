@@ -1,0 +1,324 @@
+// XPBD (lesson 12): method = "xpbd", springs as compliant distance constraints with small steps.
+// Each test states the property it checks and why the number it compares with is right; each
+// fails when the feature breaks (a forgotten lambda, a wrong compliance, substeps ignored, the
+// fast path taking the step).
+#include <doctest/doctest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <memory>
+#include <string>
+
+#include "clothlab/core/game_loop.hpp"
+#include "clothlab/core/guard.hpp"
+#include "clothlab/integrators/xpbd.hpp"
+#include "scene/scene.hpp"
+#include "test_util.hpp"
+
+using clothlab::Index;
+using clothlab::Vec3;
+using clothlab::World;
+using clothlab::Xpbd;
+
+namespace {
+
+constexpr double kG = 9.8;  // [m/s^2]
+
+// The XPBD integrator of a world, made here with the given substeps and iterations.
+Xpbd& use_xpbd(World& world, int substeps, int iterations, bool keep_lambda = true) {
+  auto xpbd = std::make_unique<Xpbd>();
+  xpbd->substeps = substeps;
+  xpbd->iterations = iterations;
+  xpbd->keep_lambda = keep_lambda;
+  Xpbd& ref = *xpbd;
+  world.integrator = std::move(xpbd);
+  return ref;
+}
+
+// A chain hanging from a pinned particle at the origin: `links` springs of ks [N/m], kd [N s/m]
+// and l0 = 1 m down -y, each free particle of mass m [kg], under gravity, starting at rest at
+// `stretch` [m] past l0 per link.
+World hanging_chain(int links, double m, double ks, double kd, double stretch = 0.0) {
+  World world;
+  world.particles.add(Vec3::Zero(), Vec3::Zero(), m);
+  clothlab::pin(world.particles, 0);
+  clothlab::SpringSet springs;
+  for (int k = 1; k <= links; ++k) {
+    world.particles.add(Vec3(0.0, -k * (1.0 + stretch), 0.0), Vec3::Zero(), m);
+    springs.add(k - 1, k, ks, kd, 1.0, world.particles.x);
+  }
+  world.force_effects.push_back(
+      std::make_unique<clothlab::SpringDampers>("springs", std::move(springs)));
+  world.force_effects.push_back(std::make_unique<clothlab::UniformGravity>(Vec3(0.0, -kG, 0.0)));
+  return world;
+}
+
+void run(World& world, double dt, long steps) {
+  for (long s = 0; s < steps; ++s)
+    world.step(dt);
+}
+
+// How far below its rest position (y = -links m) the bottom of the chain hangs [m].
+double sag(const World& world, int links) {
+  return -static_cast<double>(links) - world.particles.x(1, links);
+}
+
+}  // namespace
+
+TEST_CASE("xpbd: a hanging mass settles at the spring's static stretch m g / ks") {
+  // One substep, 1D along the constraint, v = 0 at rest, stretch s: the prediction adds
+  // dt_s^2 g; the projection (w = 1/m, the anchor pinned) gives delta_lambda = -(s + dt_s^2 g) /
+  // (w + alpha_tilde) and s' = (s + dt_s^2 g) alpha_tilde / (w + alpha_tilde). The fixed point
+  // s' = s is s w = dt_s^2 g alpha_tilde = g / ks, s = m g / ks: exactly the spring's static
+  // stretch, for any dt_s and iteration count. With m = 0.1 kg, ks = 100 N/m: 9.8 mm.
+  const double m = 0.1, ks = 100.0, expected = m * kG / ks;
+  SUBCASE("started at the stretch, it stays there (to rounding)") {
+    World world = hanging_chain(1, m, ks, 0.0, expected);
+    use_xpbd(world, 10, 1);
+    run(world, 1.0 / 60.0, 120);
+    CHECK(std::abs(sag(world, 1) - expected) <= 1e-12);
+    CHECK(world.particles.v.col(1).norm() <= 1e-9);
+  }
+  SUBCASE("started at its rest length, it swings down and settles there") {
+    // With kd = 0.5 N s/m the spring's damping ratio is kd / (2 sqrt(ks m)) = 0.079; the swing
+    // of 9.8 mm decays as exp(-2.5 t) at least (XPBD damps a little more), below 1e-12 m by
+    // t = 10 s: 1e-6 m (a 1e-4 share of the stretch) is a bound with room to spare, and a
+    // stiffness off by 1 % (98 um) fails it.
+    World world = hanging_chain(1, m, ks, 0.5);
+    use_xpbd(world, 10, 1);
+    run(world, 1.0 / 60.0, 600);
+    CHECK(sag(world, 1) == doctest::Approx(expected).epsilon(1e-4));
+  }
+}
+
+TEST_CASE("xpbd: the stiffness does not depend on the iteration count, unlike plain PBD") {
+  // The hanging mass of the test above after 10 s (dt = 1/60 s, 10 substeps). XPBD: 9.8 mm
+  // with 1 and with 10 iterations. Plain PBD (lambda forgotten, `keep_lambda = false`) repeats
+  // the first iteration n times: s' = (s + dt_s^2 g) r^n with r = alpha_tilde / (w +
+  // alpha_tilde) = 3600 / 3610, whose fixed point s = dt_s^2 g r^n / (1 - r^n) is 9.8 mm at
+  // n = 1 and 0.969 mm at n = 10: ten iterations make the spring ten times stiffer.
+  const double m = 0.1, ks = 100.0, expected = m * kG / ks;
+  const auto settled = [&](int iterations, bool keep_lambda) {
+    World world = hanging_chain(1, m, ks, 0.5);
+    use_xpbd(world, 10, iterations, keep_lambda);
+    run(world, 1.0 / 60.0, 600);
+    return sag(world, 1);
+  };
+  CHECK(settled(1, true) == doctest::Approx(expected).epsilon(1e-4));
+  CHECK(settled(10, true) == doctest::Approx(expected).epsilon(1e-4));
+  const double r = 3600.0 / 3610.0, h = 1.0 / 600.0;
+  const double pbd10 = h * h * kG * std::pow(r, 10) / (1.0 - std::pow(r, 10));
+  CHECK(settled(10, false) == doctest::Approx(pbd10).epsilon(1e-3));
+  CHECK(settled(10, false) < 0.2 * expected);
+
+  // A chain of 4 links, where one iteration does not solve the constraints exactly: link k
+  // from the top carries the (5 - k) masses below it, so the bottom hangs
+  // (4 + 3 + 2 + 1) m g / ks = 98 mm below its rest position. With one iteration and with ten
+  // it settles there within 1 % (measured: 98.14 mm and 97.97 mm), where plain PBD with ten
+  // iterations hangs ten times higher (9.8 mm).
+  const auto chain = [&](int iterations, bool keep_lambda) {
+    World world = hanging_chain(4, m, ks, 0.5);
+    use_xpbd(world, 10, iterations, keep_lambda);
+    run(world, 1.0 / 60.0, 1200);
+    return sag(world, 4);
+  };
+  const double chain_expected = 10.0 * m * kG / ks;
+  const double one = chain(1, true), ten = chain(10, true), pbd = chain(10, false);
+  MESSAGE("chain sag: xpbd 1 iteration " << one << " m, 10 iterations " << ten
+                                         << " m, plain PBD 10 iterations " << pbd << " m");
+  CHECK(one == doctest::Approx(chain_expected).epsilon(0.01));
+  CHECK(ten == doctest::Approx(chain_expected).epsilon(0.01));
+  CHECK(pbd < 0.5 * chain_expected);
+}
+
+TEST_CASE("xpbd: with more substeps a swinging spring pendulum approaches the force-based answer") {
+  // A 1 kg bob on a spring of ks = 1000 N/m from a pinned anchor, released from rest at the
+  // anchor's height 1 m away, swings under gravity for 1 s. The reference is RK4 at dt = 1e-4 s
+  // (its error there is far below the differences measured). XPBD at dt = 1/60 s with 1, 4,
+  // 16 and 64 substeps: the error falls with each (first order in dt_s, so about 4 times per
+  // step of the table), and with 64 substeps the bob is within 1 cm of the reference.
+  const auto pendulum = [](std::unique_ptr<clothlab::Integrator> integrator) {
+    World world = test::anchored_spring(1.0, 1000.0, 0.0, 0.0, 0.0);
+    world.force_effects.push_back(std::make_unique<clothlab::UniformGravity>(Vec3(0.0, -kG, 0.0)));
+    world.integrator = std::move(integrator);
+    return world;
+  };
+  World reference = pendulum(clothlab::make_integrator("rk4"));
+  run(reference, 1e-4, 10000);
+  const Vec3 x_ref = reference.particles.x.col(1);
+  double last = std::numeric_limits<double>::infinity();
+  for (int substeps : {1, 4, 16, 64}) {
+    CAPTURE(substeps);
+    World world = pendulum(std::make_unique<Xpbd>());
+    dynamic_cast<Xpbd&>(*world.integrator).substeps = substeps;
+    run(world, 1.0 / 60.0, 60);
+    const double error = (world.particles.x.col(1) - x_ref).norm();
+    MESSAGE("substeps " << substeps << ": error " << error << " m");
+    CHECK(error < 0.6 * last);
+    last = error;
+  }
+  CHECK(last < 0.01);
+}
+
+TEST_CASE("xpbd: a stiff cloth is stable at a step where explicit Euler blows up") {
+  // A 10 x 10 sheet 5 cm apart, 0.1 kg, ks = 5000 N/m, at dt = 1/60 s: each particle weighs 1 g,
+  // so its springs give w ~ sqrt(4 ks / m) ~ 4500 rad/s, and dt w ~ 75, far past any explicit
+  // method's limit (about 2). Explicit Euler is stopped by the guard; XPBD with 10 substeps runs
+  // the 2 s and ends with no more energy than gravity gave it.
+  const auto sheet = [](const std::string& method) {
+    return R"(
+[cloth]
+rows = 10
+cols = 10
+spacing = 0.05
+mass = 0.1
+pins = "top-corners"
+[springs]
+ks = 5000
+kd = 0.01
+[gravity]
+[integrator]
+dt = 0.016666666666666666
+duration = 2
+method = ")" +
+           method + "\"\n";
+  };
+  clothlab::Scene euler = clothlab::parse_scene(sheet("explicit-euler"), "stiff.toml");
+  CHECK_THROWS_AS(test::run_to_end(euler), clothlab::SimulationError);
+  clothlab::Scene xpbd = clothlab::parse_scene(sheet("xpbd"), "stiff.toml");
+  const double e0 = xpbd.world.kinetic_energy() + xpbd.world.potential_energy();
+  CHECK_NOTHROW(test::run_to_end(xpbd));
+  // The sheet falls at most its own diagonal plus the springs' stretch: 0.64 m at the most; its
+  // kinetic energy is then below m g 0.64 m = 0.63 J. A blown-up sheet has far more.
+  CHECK(xpbd.world.kinetic_energy() < 0.63);
+  CHECK(std::isfinite(e0));
+}
+
+TEST_CASE("xpbd: the energy of an undamped spring never grows") {
+  // An undamped spring (ks = 100 N/m, 1 kg, w = 10 rad/s, pulled 0.1 m, no gravity) stepped 10 s
+  // at dt = 10 ms with 4 substeps of h = 2.5 ms. On one constraint with a pinned anchor a substep
+  // of XPBD is exactly a step of implicit Euler: x* = s + h v, s' = x* / (1 + (w h)^2) and
+  // v' = (s' - s) / h are implicit Euler's s' = s + h v', v' = v - h w^2 s'. Its energy must never
+  // grow, beyond rounding (1e-12 J), and it leaks as implicit Euler's does (lesson 08): by the
+  // factor 1 / (1 + (w h)^2) a step, 0.5 J / 1.000625^4000 = 0.0411 J after 4000 substeps. A step
+  // that added energy, or lost it all, fails.
+  World world = test::anchored_spring(1.0, 100.0, 0.0, 0.1, 0.0);
+  use_xpbd(world, 4, 1);
+  const double e0 = world.kinetic_energy() + world.potential_energy();
+  double e = e0;
+  for (int s = 0; s < 1000; ++s) {
+    world.step(0.01);
+    const double next = world.kinetic_energy() + world.potential_energy();
+    REQUIRE(next <= e + 1e-12);
+    e = next;
+  }
+  const double implicit_euler = e0 * std::pow(1.0 + 0.025 * 0.025, -4000.0);
+  MESSAGE("energy " << e0 << " J -> " << e << " J; implicit Euler's factor gives " << implicit_euler
+                    << " J");
+  CHECK(e == doctest::Approx(implicit_euler).epsilon(0.02));
+}
+
+TEST_CASE("xpbd: scenes read substeps and iterations and run with pins and colliders") {
+  const std::string text = R"(
+[cloth]
+rows = 8
+cols = 8
+spacing = 0.1
+origin = [-0.35, 1.0, -0.35]
+plane = "horizontal"
+mass = 0.2
+[springs]
+ks = 2000
+kd = 0.02
+[bending]
+ks = 10
+[gravity]
+[sphere]
+centre = [0, 0.5, 0]
+radius = 0.3
+[ground]
+y = 0
+e = 0
+mu_s = 0.5
+mu_d = 0.4
+[integrator]
+method = "xpbd"
+substeps = 8
+iterations = 2
+dt = 0.01
+duration = 2
+)";
+  clothlab::Scene scene = clothlab::parse_scene(text, "drape.toml");
+  auto* xpbd = dynamic_cast<Xpbd*>(scene.world.integrator.get());
+  REQUIRE(xpbd != nullptr);
+  CHECK(xpbd->substeps == 8);
+  CHECK(xpbd->iterations == 2);
+  test::run_to_end(scene);
+  // The colliders run after each step (world.cpp) as for every method: no particle ends inside
+  // the sphere or under the ground, beyond the colliders' own tolerance of a millimetre.
+  for (Index i = 0; i < scene.world.particles.size(); ++i) {
+    const Vec3 x = scene.world.particles.x.col(i);
+    CHECK((x - Vec3(0.0, 0.5, 0.0)).norm() >= 0.3 - 1e-3);
+    CHECK(x.y() >= -1e-3);
+  }
+  // The defaults: 10 substeps, 1 iteration.
+  clothlab::Scene plain = clothlab::parse_scene(
+      "[[particle]]\nposition = [0, 0, 0]\nmass = 1\n[integrator]\nmethod = \"xpbd\"\n"
+      "dt = 0.01\nduration = 1\n",
+      "defaults.toml");
+  auto* defaults = dynamic_cast<Xpbd*>(plain.world.integrator.get());
+  REQUIRE(defaults != nullptr);
+  CHECK(defaults->substeps == 10);
+  CHECK(defaults->iterations == 1);
+}
+
+TEST_CASE("xpbd: a pinned corner stays put and a storm tears the sheet") {
+  // The storm sheet of tearing.cpp, stepped by XPBD: the pins (w = 0) never move, and springs
+  // past the tearing strain are removed between steps; the integrator finds the springs left
+  // at each step.
+  clothlab::Scene scene = clothlab::parse_scene(
+      test::storm("[tearing]\nstrain = 0.3\n") + "method = \"xpbd\"\nsubsteps = 4\n", "storm.toml");
+  const size_t springs_before = test::springs_of(scene.world).size();
+  const Vec3 pin = scene.world.particles.x.col(0);
+  for (long s = 0; s < 2000; ++s)
+    scene.world.step(scene.dt);
+  CHECK(scene.world.particles.x.col(0) == pin);
+  CHECK(test::springs_of(scene.world).size() < springs_before);
+}
+
+TEST_CASE("xpbd: the fast path leaves the step to the readable code, with the same result") {
+  // FastEngine takes whole steps for the Euler methods only; an XPBD step sums its external
+  // forces effect by effect itself. With and without the backend: the same state, bit for bit,
+  // and the backend took no step and no force sum.
+  const std::string text = test::storm() + "method = \"xpbd\"\n";
+  clothlab::Scene fast = clothlab::parse_scene(text, "storm.toml");
+  clothlab::Scene readable = clothlab::parse_scene(text, "storm.toml");
+  readable.world.backend.reset();
+  REQUIRE(fast.world.backend != nullptr);
+  clothlab::StepTimes times;
+  fast.world.timing = &times;
+  for (int s = 0; s < 200; ++s) {
+    fast.world.step(fast.dt);
+    readable.world.step(readable.dt);
+  }
+  CHECK(times.backend_steps == 0.0);
+  CHECK(fast.world.fast_evaluations == 0);
+  const bool same_x = fast.world.particles.x == readable.world.particles.x;
+  const bool same_v = fast.world.particles.v == readable.world.particles.v;
+  CHECK(same_x);
+  CHECK(same_v);
+}
+
+TEST_CASE("xpbd: the game loop drives an XPBD scene the same for any split into frames") {
+  const std::string text = test::storm() + "method = \"xpbd\"\nsubsteps = 4\n";
+  clothlab::Simulation one(clothlab::parse_scene(text, "storm.toml"), 100000);
+  clothlab::Simulation many(clothlab::parse_scene(text, "storm.toml"), 100000);
+  one.advance(0.1);
+  for (int k = 0; k < 6; ++k)
+    many.advance(1.0 / 60.0);
+  REQUIRE(one.steps() == 500);
+  REQUIRE(many.steps() == 500);
+  const bool same = one.positions() == many.positions();
+  CHECK(same);
+}
