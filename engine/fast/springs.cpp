@@ -31,8 +31,8 @@
 #include "fast/springs.hpp"
 
 #include <algorithm>
-#include <bit>
 #include <cstdint>
+#include <cstring>
 
 #include "fast/forces.hpp"
 
@@ -41,8 +41,12 @@ namespace {
 
 // The same double, bit for bit: -0.0 and 0.0 differ here, which == would not see, and the fast
 // path must compute a uniform run's springs with their own bits.
+// (memcpy rather than std::bit_cast, which the C++ library of the WebAssembly build lacks.)
 bool same_bits(double a, double b) {
-  return std::bit_cast<std::uint64_t>(a) == std::bit_cast<std::uint64_t>(b);
+  std::uint64_t bits_a, bits_b;
+  std::memcpy(&bits_a, &a, sizeof a);
+  std::memcpy(&bits_b, &b, sizeof b);
+  return bits_a == bits_b;
 }
 
 }  // namespace

@@ -1,0 +1,305 @@
+// live.cpp: the engine as the live lesson pages see it, compiled to WebAssembly.
+//
+// The page drives one Simulation (clothlab/core/game_loop.hpp, lesson 11) through these few C
+// functions: it loads a scene from TOML text, advances it by the frame times of the browser,
+// reads the positions and the energies straight out of the module's memory, and pins, drags and
+// frees particles with the mouse. A slider is a number in the scene's TOML: the page changes the
+// text and calls clothlab_reload(), which reads the scene again and carries the motion over (the
+// particles' positions and velocities, the time), so the change takes effect while it runs.
+//
+// Every function returns a status and leaves a message in clothlab_message() when it fails: the
+// scene reader's FILE:LINE:COL errors, the guard's blow-up report, an exercise that is still a
+// stub (NotImplemented names the exercise and the lesson).
+#include <emscripten/emscripten.h>
+
+#include <algorithm>
+#include <exception>
+#include <memory>
+#include <optional>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include <fmt/format.h>
+#include <toml++/toml.h>
+#include <nlohmann/json.hpp>
+
+#include "clothlab/core/game_loop.hpp"
+#include "clothlab/core/guard.hpp"
+#include "clothlab/core/not_implemented.hpp"
+#include "clothlab/forces/spring_damper.hpp"
+#include "clothlab/integrators/integrator.hpp"
+#include "scene/scene.hpp"
+
+namespace {
+
+using clothlab::Index;
+using clothlab::Simulation;
+
+std::unique_ptr<Simulation> g_simulation;
+std::string g_message;         // what the last call that failed said
+std::string g_parameters;      // JSON: the numbers of the scene a slider may change
+std::vector<int> g_triangles;  // the surface as 32-bit indices, for WebGL
+std::vector<int> g_springs;    // spring ends, for drawing the springs
+std::vector<double> g_shown;   // positions to draw, 3 per particle
+std::vector<unsigned char> g_pinned_by_scene;
+
+enum Status : int { kOk = 0, kBadScene = 1, kBlewUp = 2, kNotDone = 3, kFailed = 4 };
+
+// Runs `work`, turning an exception into a status and a message.
+template <typename Work>
+int guarded(Work&& work) {
+  try {
+    work();
+    return kOk;
+  } catch (const clothlab::SceneError& error) {
+    g_message = error.what();
+    return kBadScene;
+  } catch (const clothlab::SimulationError& error) {
+    g_message = error.what();
+    return kBlewUp;
+  } catch (const clothlab::NotImplemented& error) {
+    g_message = error.what();
+    return kNotDone;
+  } catch (const std::exception& error) {
+    g_message = error.what();
+    return kFailed;
+  }
+}
+
+// The numbers of a scene a page may turn into sliders: every number (or element of an array of
+// numbers) of every table, with where its text is, so the page can put a new value in its place.
+void list_numbers(const toml::table& table, const std::string& prefix, nlohmann::json& out) {
+  for (const auto& [key, node] : table) {
+    const std::string name =
+        prefix.empty() ? std::string(key.str()) : prefix + "." + std::string(key.str());
+    const auto add = [&](const toml::node& value, const std::string& label) {
+      const toml::source_region& where = value.source();
+      out.push_back({{"name", label},
+                     {"value", value.value<double>().value_or(0.0)},
+                     {"integer", value.is_integer()},
+                     {"line", where.begin.line},
+                     {"column", where.begin.column},
+                     {"end_line", where.end.line},
+                     {"end_column", where.end.column}});
+    };
+    if (node.is_number()) {
+      add(node, name);
+    } else if (const toml::table* inner = node.as_table()) {
+      list_numbers(*inner, name, out);
+    } else if (const toml::array* array = node.as_array()) {
+      const bool all_numbers = std::all_of(array->begin(), array->end(),
+                                           [](const toml::node& n) { return n.is_number(); });
+      if (all_numbers && array->size() <= 4) {
+        for (size_t k = 0; k < array->size(); ++k)
+          add((*array)[k], fmt::format("{}[{}]", name, k));
+      }
+    }
+  }
+}
+
+void describe(const std::string& text) {
+  nlohmann::json numbers = nlohmann::json::array();
+  try {
+    list_numbers(toml::parse(text), "", numbers);
+  } catch (const std::exception&) {
+    // The scene reader has read it: this cannot fail; if it does, no sliders.
+  }
+  g_parameters = numbers.dump();
+}
+
+// The byte offset in `text` of a toml++ position (line and column from 1, the column counted
+// in characters).
+size_t offset_of(const std::string& text, const toml::source_position& at) {
+  size_t offset = 0;
+  for (toml::source_index line = 1; line < at.line && offset < text.size(); ++line) {
+    const size_t end = text.find('\n', offset);
+    offset = end == std::string::npos ? text.size() : end + 1;
+  }
+  for (toml::source_index column = 1; column < at.column && offset < text.size(); ++column) {
+    ++offset;
+    while (offset < text.size() && (static_cast<unsigned char>(text[offset]) & 0xC0) == 0x80)
+      ++offset;  // the rest of a character of several bytes
+  }
+  return offset;
+}
+
+// `text` with the value at `path` ("springs.ks", "aerodynamics.wind[0]") replaced by
+// `value` (TOML text); a key its table lacks is added under the table's header, a table the
+// scene lacks at the end.
+std::string edited(const std::string& text, const std::string& path, const std::string& value) {
+  const toml::table root = toml::parse(text);
+  if (const toml::node* node = root.at_path(path).node()) {
+    const size_t begin = offset_of(text, node->source().begin);
+    const size_t end = offset_of(text, node->source().end);
+    return text.substr(0, begin) + value + text.substr(end);
+  }
+  const size_t dot = path.rfind('.');
+  if (dot == std::string::npos || path.find('[') != std::string::npos) {
+    throw std::invalid_argument(fmt::format("the scene has no {} to change", path));
+  }
+  const std::string table = path.substr(0, dot), key = path.substr(dot + 1);
+  if (const toml::table* t = root.at_path(table).as_table(); t && !t->is_inline()) {
+    const size_t header = offset_of(text, t->source().begin);
+    const size_t line_end = text.find('\n', header);
+    const size_t at = line_end == std::string::npos ? text.size() : line_end + 1;
+    const std::string before = line_end == std::string::npos ? "\n" : "";
+    return text.substr(0, at) + before + key + " = " + value + "\n" + text.substr(at);
+  }
+  return text + (text.empty() || text.back() == '\n' ? "" : "\n") + "\n[" + table + "]\n" + key +
+         " = " + value + "\n";
+}
+
+// The surface and the springs as 32-bit indices, for drawing.
+void take_surface() {
+  const clothlab::World& world = g_simulation->world();
+  g_triangles.clear();
+  for (const clothlab::Triangle& t : world.triangles)
+    g_triangles.insert(g_triangles.end(), t.begin(), t.end());
+  g_springs.clear();
+  for (const auto& effect : world.force_effects) {
+    if (const auto* family = dynamic_cast<const clothlab::SpringDampers*>(effect.get())) {
+      if (family->name() != "springs") continue;  // bending springs are not drawn
+      const clothlab::SpringSet& set = family->springs();
+      for (size_t k = 0; k < set.size(); ++k) {
+        g_springs.push_back(static_cast<int>(set.i(k)));
+        g_springs.push_back(static_cast<int>(set.j(k)));
+      }
+    }
+  }
+}
+
+}  // namespace
+
+extern "C" {
+
+// Reads `text` as the scene `name` and starts it from its beginning.
+EMSCRIPTEN_KEEPALIVE int clothlab_load(const char* text, const char* name) {
+  return guarded([&] {
+    clothlab::Scene scene = clothlab::parse_scene(text, name);
+    scene.world.threads = 1;  // one thread in a page
+    g_simulation = std::make_unique<Simulation>(std::move(scene));
+    const clothlab::Particles& p = g_simulation->world().particles;
+    g_pinned_by_scene.assign(static_cast<size_t>(p.size()), 0);
+    for (Index i = 0; i < p.size(); ++i)
+      g_pinned_by_scene[static_cast<size_t>(i)] = p.inv_m[i] == 0.0;
+    take_surface();
+    describe(text);
+  });
+}
+
+// Reads `text` again and carries the running motion over: the positions, velocities and time
+// of the particles, when the new scene has as many. The pins of the new scene hold where the
+// particles are now.
+EMSCRIPTEN_KEEPALIVE int clothlab_reload(const char* text, const char* name) {
+  if (!g_simulation) return clothlab_load(text, name);
+  const clothlab::World& old = g_simulation->world();
+  const clothlab::Matrix3X x = old.particles.x, v = old.particles.v;
+  const double t = old.t;
+  const int status = clothlab_load(text, name);
+  if (status != kOk) return status;
+  clothlab::World& world = g_simulation->world();
+  if (world.particles.size() != x.cols()) return kOk;  // another cloth: it starts over
+  world.particles.x = x;
+  world.particles.v = v;
+  world.t = t;  // steps stays 0: the guard starts again from the state carried over
+  return kOk;
+}
+
+EMSCRIPTEN_KEEPALIVE const char* clothlab_message() {
+  return g_message.c_str();
+}
+
+// `text` with one value changed (see edited() above); null, with a message, if it cannot be.
+EMSCRIPTEN_KEEPALIVE const char* clothlab_edit(const char* text, const char* path,
+                                               const char* value) {
+  static std::string result;
+  const int status = guarded([&] { result = edited(text, path, value); });
+  return status == kOk ? result.c_str() : nullptr;
+}
+
+// The integrators a scene may name, as a JSON array.
+EMSCRIPTEN_KEEPALIVE const char* clothlab_integrators() {
+  static std::string names;
+  nlohmann::json list = nlohmann::json::array();
+  for (std::string_view name : clothlab::method_names())
+    list.push_back(std::string(name));
+  names = list.dump();
+  return names.c_str();
+}
+EMSCRIPTEN_KEEPALIVE const char* clothlab_parameters() {
+  return g_parameters.c_str();
+}
+
+// Advances by `frame_time` seconds of simulated time; returns the status (the steps taken are in
+// clothlab_steps()).
+EMSCRIPTEN_KEEPALIVE int clothlab_advance(double frame_time) {
+  if (!g_simulation) return kFailed;
+  return guarded([&] {
+    g_simulation->advance(frame_time);
+    // A tear (lesson 06) changes the surface.
+    if (g_simulation->world().triangles.size() * 3 != g_triangles.size()) take_surface();
+  });
+}
+
+EMSCRIPTEN_KEEPALIVE double clothlab_time() {
+  return g_simulation ? g_simulation->time() : 0.0;
+}
+EMSCRIPTEN_KEEPALIVE double clothlab_dt() {
+  return g_simulation ? g_simulation->dt() : 0.0;
+}
+EMSCRIPTEN_KEEPALIVE double clothlab_steps() {
+  return g_simulation ? static_cast<double>(g_simulation->steps()) : 0.0;
+}
+EMSCRIPTEN_KEEPALIVE double clothlab_kinetic() {
+  return g_simulation ? g_simulation->world().kinetic_energy() : 0.0;
+}
+EMSCRIPTEN_KEEPALIVE double clothlab_potential() {
+  return g_simulation ? g_simulation->world().potential_energy() : 0.0;
+}
+EMSCRIPTEN_KEEPALIVE int clothlab_particles() {
+  return g_simulation ? static_cast<int>(g_simulation->world().particles.size()) : 0;
+}
+
+// The positions to draw (between the last two steps, lesson 11), 3 doubles per particle.
+EMSCRIPTEN_KEEPALIVE const double* clothlab_positions() {
+  const clothlab::Matrix3X& x = g_simulation->interpolated_positions();
+  g_shown.assign(x.data(), x.data() + x.size());
+  return g_shown.data();
+}
+EMSCRIPTEN_KEEPALIVE int clothlab_triangle_count() {
+  return static_cast<int>(g_triangles.size() / 3);
+}
+EMSCRIPTEN_KEEPALIVE const int* clothlab_triangles() {
+  return g_triangles.data();
+}
+EMSCRIPTEN_KEEPALIVE int clothlab_spring_count() {
+  return static_cast<int>(g_springs.size() / 2);
+}
+EMSCRIPTEN_KEEPALIVE const int* clothlab_springs() {
+  return g_springs.data();
+}
+
+// Whether particle i is pinned (by the scene, or held by the mouse).
+EMSCRIPTEN_KEEPALIVE int clothlab_is_pinned(int i) {
+  return g_simulation && g_simulation->world().particles.inv_m[i] == 0.0;
+}
+EMSCRIPTEN_KEEPALIVE int clothlab_pinned_by_scene(int i) {
+  return i >= 0 && static_cast<size_t>(i) < g_pinned_by_scene.size() &&
+         g_pinned_by_scene[static_cast<size_t>(i)];
+}
+
+// The mouse: hold particle i, move it towards (x, y, z) over the next frame, let it go.
+EMSCRIPTEN_KEEPALIVE int clothlab_grab(int i) {
+  return guarded([&] { g_simulation->pin(i); });
+}
+EMSCRIPTEN_KEEPALIVE int clothlab_drag(int i, double x, double y, double z) {
+  return guarded([&] { g_simulation->move_pin(i, clothlab::Vec3(x, y, z)); });
+}
+EMSCRIPTEN_KEEPALIVE int clothlab_release(int i) {
+  return guarded([&] {
+    if (!clothlab_pinned_by_scene(i)) g_simulation->unpin(i);
+  });
+}
+
+}  // extern "C"

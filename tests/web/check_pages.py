@@ -1,0 +1,97 @@
+#!/usr/bin/env python3
+"""Opens each live lesson page in headless Chromium with page_test.js put into a copy of it, and
+checks what the test found: no console error, time advances in every scene, a slider changes
+the motion, a drag moves the grabbed particle, an edited scene's error shows FILE:LINE:COL (and,
+on a student page built on the stubs, the exercise's message)."""
+
+import argparse
+import base64
+import json
+import os
+import pathlib
+import re
+import shutil
+import subprocess
+import sys
+import tempfile
+import threading
+
+CAPTURE = """<script>
+window.__clothlabErrors = [];
+window.addEventListener('error', (e) => window.__clothlabErrors.push(String(e.message)));
+window.addEventListener('unhandledrejection', (e) => window.__clothlabErrors.push(String(e.reason)));
+const __clothlabConsoleError = console.error;
+console.error = (...args) => { window.__clothlabErrors.push(args.join(' ')); __clothlabConsoleError(...args); };
+</script>"""
+
+
+def browser() -> str:
+    for name in ("chromium", "chromium-browser", "google-chrome"):
+        if shutil.which(name):
+            return name
+    if os.environ.get("CLOTHLAB_REQUIRE_WEB") == "1" or os.environ.get("CLOTHLAB_REQUIRE_BROWSER") == "1":
+        sys.exit("check_pages: no Chromium found (apt-get install -y chromium)")
+    print("check_pages: no Chromium found (apt-get install -y chromium): skipped")
+    sys.exit(77)
+
+
+def run_until_reported(command: list, tag: str, timeout: float):
+    """Runs the browser until a console line starting with `tag` arrives (its base64 JSON is
+    returned), or `timeout` seconds pass (None). Real time: the page's clock is not virtual."""
+    process = subprocess.Popen(command, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE,
+                               text=True)
+    timer = threading.Timer(timeout, process.kill)
+    timer.start()
+    try:
+        for line in process.stderr:
+            at = line.find(tag)
+            if at >= 0:
+                encoded = re.match(r"[A-Za-z0-9+/=]+", line[at + len(tag):]).group(0)
+                return json.loads(base64.b64decode(encoded).decode("utf-8"))
+        return None
+    finally:
+        timer.cancel()
+        process.kill()
+        process.wait()
+
+
+def check(page: pathlib.Path, test_script: str, work: pathlib.Path) -> list:
+    text = page.read_text(encoding="utf-8")
+    text = text.replace("<head>", "<head>\n" + CAPTURE, 1)
+    text = text.replace("</body>", "<script>" + test_script + "</script>\n</body>", 1)
+    copy = work / page.name
+    copy.write_text(text, encoding="utf-8")
+    command = [browser(), "--headless", "--no-sandbox", "--disable-dev-shm-usage",
+               "--use-angle=swiftshader", "--enable-unsafe-swiftshader",
+               "--window-size=1200,800", "--enable-logging=stderr", "--v=0",
+               copy.resolve().as_uri()]
+    results = run_until_reported(command, "CLOTHLAB-TEST ", timeout=240)
+    if results is None:
+        return [f"{page.name}: the page reported nothing within 240 s"]
+    problems = [f"{page.name}: console error: {e}" for e in results["errors"]]
+    for c in results["checks"]:
+        status = "ok  " if c["ok"] else "FAIL"
+        print(f"  {status} {page.name}: {c['name']}")
+        if not c["ok"]:
+            problems.append(f"{page.name}: {c['name']}: {c['detail']}")
+    if not results["checks"]:
+        problems.append(f"{page.name}: no check ran")
+    return problems
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__)
+    parser.add_argument("pages", nargs="+", type=pathlib.Path)
+    args = parser.parse_args()
+    test_script = (pathlib.Path(__file__).parent / "page_test.js").read_text(encoding="utf-8")
+    problems = []
+    with tempfile.TemporaryDirectory(prefix="clothlab-pages-") as work:
+        for page in args.pages:
+            problems += check(page, test_script, pathlib.Path(work))
+    for p in problems:
+        print(p, file=sys.stderr)
+    sys.exit(1 if problems else 0)
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,119 @@
+// page_test.js: put into a copy of a live lesson page by check_pages.py, it drives the page the
+// way a student would (its own functions, the ones the controls and the mouse call) and logs
+// what it found to the console as one line, "CLOTHLAB-TEST " and the results as base64 JSON,
+// which the driver reads from the browser's log.
+'use strict';
+
+(function () {
+  const results = { checks: [], errors: window.__clothlabErrors };
+  const say = (name, ok, detail) => results.checks.push({ name, ok: !!ok, detail: String(detail) });
+  const finish = () => {
+    const json = JSON.stringify(results);
+    const bytes = new TextEncoder().encode(json);
+    let binary = '';
+    for (const b of bytes) binary += String.fromCharCode(b);
+    console.log('CLOTHLAB-TEST ' + btoa(binary));
+  };
+
+  function run() {
+    const page = window.clothlabPage;
+    const api = page.api;
+    const student = page.lesson.kernels !== 'solutions';
+    page.setRunning(false);
+    const first = page.lesson.scenes[0];
+
+    // A student page on stubs: the first step names the exercise to do.
+    if (student) {
+      page.load(first.text, first.name);
+      page.advance(0.05);
+      const message = page.message();
+      say('a stub shows its exercise', /exercise|ex\d\d/i.test(message) && /lesson/i.test(message), message);
+      return;
+    }
+
+    for (const scene of page.lesson.scenes) {
+      // Time advances.
+      if (!page.load(scene.text, scene.name)) {
+        say(`${scene.name} loads`, false, page.message());
+        continue;
+      }
+      page.setRunning(false);
+      // Frames of 1/60 s for a sixth of a second, or three steps of a scene's larger dt.
+      const t0 = api.time(), span = Math.max(1 / 6, 3 * api.dt());
+      let ok = true;
+      for (let t = 0; t < span - 1e-9 && ok; t += 1 / 60) ok = page.advance(1 / 60);
+      if (ok) {
+        say(`${scene.name}: simulated time advances`, api.time() >= t0 + span - api.dt() - 1e-9,
+            `t = ${api.time()} after ${span} s of frames (dt = ${api.dt()})`);
+      } else {
+        // A scene that blows up on purpose (lesson 08) stops with the guard's message.
+        say(`${scene.name}: the run stops with the guard's message`,
+            /blew up|guard/.test(page.message()) && api.time() > t0, page.message());
+      }
+    }
+
+    // A slider changes the motion: the same scene, run twice for 0.3 s, once with the first
+    // slider's number five times larger (or 1 if it is 0).
+    page.load(first.text, first.name);
+    page.setRunning(false);
+    const sliders = Array.from(document.querySelectorAll('#sliders input'));
+    if (sliders.length) {
+      for (let k = 0; k < 18; ++k) page.advance(1 / 60);
+      const plain = page.positions();
+      page.load(first.text, first.name);
+      page.setRunning(false);
+      const name = sliders[0].dataset.name;
+      const p = page.parameters().find((q) => q.name === name);
+      const value = p.value === 0 ? 1 : p.value * 5;
+      const changed = page.setParameter(name, value);
+      for (let k = 0; k < 18; ++k) page.advance(1 / 60);
+      const other = page.positions();
+      let diff = 0;
+      for (let k = 0; k < plain.length; ++k) diff = Math.max(diff, Math.abs(plain[k] - other[k]));
+      say(`the slider ${name} changes the motion`, changed && diff > 1e-6,
+          `max difference ${diff} m; ${page.message()}`);
+      say(`the slider ${name} is in the scene's text`, page.sceneText().includes(String(value)), page.sceneText());
+    } else {
+      say('the first scene has sliders', false, 'none');
+    }
+
+    // A drag: hold a free particle and pull it; it follows the mouse.
+    page.load(first.text, first.name);
+    page.setRunning(false);
+    page.view.draw();
+    let free = -1;
+    for (let i = 0; i < api.particles(); ++i) if (!api.isPinned(i)) { free = i; break; }
+    if (free >= 0) {
+      const [sx, sy] = page.view.screenOf(free);
+      const grabbed = page.grabAt(sx, sy);
+      const before = page.positions().slice(3 * grabbed, 3 * grabbed + 3);
+      page.dragTo(sx + 60, sy - 60);
+      const span = Math.max(0.1, 3 * api.dt());
+      for (let t = 0; t < span - 1e-9; t += 1 / 60) page.advance(1 / 60);
+      const after = page.positions().slice(3 * grabbed, 3 * grabbed + 3);
+      const moved = Math.hypot(after[0] - before[0], after[1] - before[1], after[2] - before[2]);
+      say('a drag moves the grabbed particle', grabbed >= 0 && moved > 1e-4 && api.isPinned(grabbed),
+          `particle ${grabbed} moved ${moved} m`);
+      page.release();
+      say('a released particle is free again', !api.isPinned(grabbed), grabbed);
+    }
+
+    // An edited scene with an error shows FILE:LINE:COL.
+    const lines = first.text.split('\n').length;
+    page.load(first.text + (first.text.endsWith('\n') ? '' : '\n') + 'mistake = 1\n', first.name);
+    const expected = `${first.name}:${lines + (first.text.endsWith('\n') ? 0 : 1)}:1:`;
+    say('an error in an edited scene shows its line and column', page.message().includes(expected),
+        `${page.message()} (expected ${expected})`);
+  }
+
+  function start() {
+    try {
+      run();
+    } catch (e) {
+      say('the test ran', false, `${e}\n${e.stack}`);
+    }
+    finish();
+  }
+  if (window.clothlabPage && window.clothlabPage.ready) start();
+  else document.addEventListener('clothlab-ready', start);
+})();
