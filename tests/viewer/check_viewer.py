@@ -87,8 +87,9 @@ def main():
         return 1 if os.environ.get("CLOTHLAB_REQUIRE_BROWSER") == "1" else 77
 
     os.makedirs(args.work, exist_ok=True)
-    page = os.path.join(args.work, "view.html")
-    subprocess.run([args.clothlab, "run", args.scene, "--out", args.work, "--html", page],
+    run = os.path.join(args.work, "run")  # the run's own folder; the screenshots beside it
+    page = os.path.join(run, "view.html")
+    subprocess.run([args.clothlab, "run", args.scene, "--out", run, "--html", page],
                    check=True, stdout=subprocess.DEVNULL)
     profile = tempfile.mkdtemp(prefix="clothlab-chromium-")
     try:
