@@ -185,10 +185,10 @@
 
   // The text of [table] in a scene, up to the next table.
   function section(text, table) {
-    const start = text.search(new RegExp(`^\\s*\\[${table}\\]`, 'm'));
-    if (start < 0) return '';
-    const rest = text.slice(start + 1);
-    const next = rest.search(/^\s*\[/m);
+    const header = new RegExp(`^[ \\t]*\\[${table}\\][^\\n]*$`, 'm').exec(text);
+    if (!header) return '';
+    const rest = text.slice(header.index + header[0].length);
+    const next = rest.search(/^[ \t]*\[/m);
     return next < 0 ? rest : rest.slice(0, next);
   }
 

@@ -38,6 +38,10 @@
         continue;
       }
       page.setRunning(false);
+      const method = /^\s*method\s*=\s*"([^"]+)"/m.exec(scene.text);
+      const shown = document.getElementById('integrator').value;
+      say(`${scene.name}: the integrator menu shows the scene's method`,
+          shown === (method ? method[1] : 'symplectic-euler'), shown);
       // Frames of 1/60 s for a sixth of a second, or three steps of a scene's larger dt.
       const t0 = api.time(), span = Math.max(1 / 6, 3 * api.dt());
       let ok = true;
