@@ -140,7 +140,9 @@ void print_scene_warnings(const Scene& scene) {
 }
 
 int run(Scene& scene, const RunOutputs& outputs, bool stats) {
-  const fs::path& out_dir = outputs.dir;
+  // The folder as a user reads it: "out/" and "./out" are "out".
+  fs::path out_dir = outputs.dir.lexically_normal();
+  if (!out_dir.has_filename() && out_dir.has_parent_path()) out_dir = out_dir.parent_path();
   StepTimes times;
   if (stats) scene.world.timing = &times;
   fmt::print("clothlab ({} build): {}{}\n", app::kKernels, scene.source,
@@ -180,7 +182,7 @@ int run(Scene& scene, const RunOutputs& outputs, bool stats) {
                report.wall_seconds, energy_start, energy_end);
     fmt::print("  wrote {} frames to {}/: ", report.frames, out_dir.string());
     for (const fs::path& file : report.files) {
-      const bool inside = file.parent_path() == out_dir;
+      const bool inside = file.parent_path().lexically_normal() == out_dir;
       fmt::print("{} ", inside ? file.filename().string() : file.string());
     }
     fmt::print("\n");

@@ -83,7 +83,11 @@ RunReport run_scene(Scene& scene, const RunOutputs& outputs, const ProgressFn& p
   // Everything that can be found wrong with the outputs is found before the first step.
   const bool page = !outputs.html.empty();
   // A page outside the folder is checked first, so that a bad --html creates no folder.
-  const bool page_inside = page && outputs.html.parent_path() == outputs.dir;
+  const auto folder_of = [](std::filesystem::path p) {  // "out/" and "./out" are "out"
+    p = p.lexically_normal();
+    return !p.has_filename() && p.has_parent_path() ? p.parent_path() : p;
+  };
+  const bool page_inside = page && folder_of(outputs.html.parent_path()) == folder_of(outputs.dir);
   if (page && !page_inside) check_page_target(outputs.html, outputs.force);
   RunFolder folder(outputs.dir, outputs.force);
   if (page_inside) check_page_target(outputs.html, outputs.force);

@@ -222,6 +222,16 @@ TEST_CASE("outputs: --html over a file that is not a viewer page is refused unle
   CHECK(read_all(dir / "report.html") == "<html>my report</html>");
 }
 
+TEST_CASE("outputs: --out with a trailing slash or a ./ is the same folder as without") {
+  for (const std::string spelling : {"/", "/./", "/.//"}) {
+    const fs::path dir = fresh_dir("slash");
+    clothlab::Scene scene = clothlab::parse_scene(kCloth, "<cloth>");
+    const clothlab::RunReport report = clothlab::run_scene(scene, dir.string() + spelling);
+    CHECK(report.frames == 21);
+    CHECK(fs::exists(dir / "view.html"));
+  }
+}
+
 TEST_CASE("outputs: a second run clears the first run's frames and leaves the user's files") {
   const fs::path dir = fresh_dir("rerun");
   {
