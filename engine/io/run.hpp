@@ -40,8 +40,9 @@ using ProgressFn = std::function<void(long, long)>;
 
 // While alive, SIGINT (Ctrl-C) and SIGTERM ask a run to stop after its current step instead of
 // ending the process at once; run_scene then writes that step as a last frame and the page, and
-// throws RunStopped. A second signal ends the process as usual (the files stay whole). SIGXFSZ
-// is ignored meanwhile, so that a file past the size limit is an OutputError that names it.
+// throws RunStopped. A second signal ends the process as usual (and may cut the frame being
+// written). SIGXFSZ is ignored meanwhile, so that a file past the size limit is an OutputError
+// that names it.
 class StopSignals {
  public:
   StopSignals();
