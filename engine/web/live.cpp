@@ -13,7 +13,9 @@
 #include <emscripten/emscripten.h>
 
 #include <algorithm>
+#include <cmath>
 #include <exception>
+#include <map>
 #include <memory>
 #include <optional>
 #include <stdexcept>
@@ -24,6 +26,8 @@
 #include <toml++/toml.h>
 #include <nlohmann/json.hpp>
 
+#include "clothlab/after_step/ground_collision.hpp"
+#include "clothlab/after_step/tearing.hpp"
 #include "clothlab/core/game_loop.hpp"
 #include "clothlab/core/guard.hpp"
 #include "clothlab/core/not_implemented.hpp"
@@ -169,6 +173,58 @@ void take_surface() {
   }
 }
 
+// A spring known by its two ends, the smaller first: what stays the same when a scene is read
+// again, whatever order its springs are built in.
+using Ends = std::pair<Index, Index>;
+using RestLengths = std::map<Ends, double>;
+
+Ends ends_of(const clothlab::SpringSet& s, size_t k) {
+  return {std::min(s.i(k), s.j(k)), std::max(s.i(k), s.j(k))};
+}
+
+// The rest length of each spring of the family `name` ("springs" or "bending"), or nothing when
+// the world has no such family.
+std::optional<RestLengths> rest_lengths(const clothlab::World& world, std::string_view name) {
+  const clothlab::SpringDampers* family = clothlab::find_spring_effect(world, name);
+  if (!family) return std::nullopt;
+  RestLengths lengths;
+  const clothlab::SpringSet& s = family->springs();
+  for (size_t k = 0; k < s.size(); ++k)
+    lengths[ends_of(s, k)] = s.l0(k);
+  return lengths;
+}
+
+// What a running cloth has become that its scene does not say (lesson 06): the rest lengths its
+// springs have yielded to, and the springs it has torn. A scene read again for a slider starts
+// from its text, so this gives them back: each spring of `family` keeps the rest length it had
+// in `before`, and a spring `before` no longer had is torn again (with its triangles and the
+// bending springs across it, as the tearing effect does), or simply dropped without one.
+void carry_springs(clothlab::World& world, std::string_view family,
+                   const std::optional<RestLengths>& before) {
+  clothlab::SpringDampers* effect = clothlab::find_spring_effect(world, family);
+  if (!effect || !before) return;
+  clothlab::SpringSet& s = effect->springs();
+  std::vector<size_t> lost;
+  for (size_t k = 0; k < s.size(); ++k) {
+    const auto it = before->find(ends_of(s, k));
+    if (it == before->end()) {
+      lost.push_back(k);
+    } else {
+      s.set_l0(k, it->second);
+    }
+  }
+  if (lost.empty()) return;
+  clothlab::Tearing* tearing = nullptr;
+  for (const auto& after : world.post_step_effects) {
+    if (auto* t = dynamic_cast<clothlab::Tearing*>(after.get())) tearing = t;
+  }
+  if (tearing && family == "springs") {
+    tearing->tear(world, lost);
+  } else {
+    s.erase(lost);
+  }
+}
+
 }  // namespace
 
 extern "C" {
@@ -188,14 +244,17 @@ EMSCRIPTEN_KEEPALIVE int clothlab_load(const char* text, const char* name) {
   });
 }
 
-// Reads `text` again and carries the running motion over: the positions, velocities and time
-// of the particles, when the new scene has as many. The pins of the new scene hold where the
+// Reads `text` again and carries the running motion over, when the new scene has as many
+// particles: their positions, velocities and time, and what the springs have become (yielded
+// rest lengths, torn springs: carry_springs above). The pins of the new scene hold where the
 // particles are now.
 EMSCRIPTEN_KEEPALIVE int clothlab_reload(const char* text, const char* name) {
   if (!g_simulation) return clothlab_load(text, name);
   const clothlab::World& old = g_simulation->world();
   const clothlab::Matrix3X x = old.particles.x, v = old.particles.v;
   const double t = old.t;
+  const std::optional<RestLengths> springs = rest_lengths(old, "springs");
+  const std::optional<RestLengths> bending = rest_lengths(old, "bending");
   const int status = clothlab_load(text, name);
   if (status != kOk) return status;
   clothlab::World& world = g_simulation->world();
@@ -203,7 +262,11 @@ EMSCRIPTEN_KEEPALIVE int clothlab_reload(const char* text, const char* name) {
   world.particles.x = x;
   world.particles.v = v;
   world.t = t;  // steps stays 0: the guard starts again from the state carried over
-  return kOk;
+  return guarded([&] {
+    carry_springs(world, "springs", springs);
+    carry_springs(world, "bending", bending);
+    take_surface();
+  });
 }
 
 EMSCRIPTEN_KEEPALIVE const char* clothlab_message() {
@@ -231,14 +294,48 @@ EMSCRIPTEN_KEEPALIVE const char* clothlab_parameters() {
   return g_parameters.c_str();
 }
 
+// The method the scene's integrator is ("symplectic-euler", "xpbd", ...).
+EMSCRIPTEN_KEEPALIVE const char* clothlab_method() {
+  static std::string method;
+  method = g_simulation ? std::string(g_simulation->world().integrator->name()) : "";
+  return method.c_str();
+}
+
+// The solids the cloth meets, as the engine has them, for drawing: a JSON object with "ground"
+// (its height, or null), "planes" ([{point, normal}]) and "spheres" ([{centre, radius}]).
+EMSCRIPTEN_KEEPALIVE const char* clothlab_colliders() {
+  static std::string colliders;
+  nlohmann::json out = {{"ground", nullptr},
+                        {"planes", nlohmann::json::array()},
+                        {"spheres", nlohmann::json::array()}};
+  const auto vec = [](const clothlab::Vec3& v) { return nlohmann::json{v.x(), v.y(), v.z()}; };
+  if (g_simulation) {
+    for (const auto& effect : g_simulation->world().post_step_effects) {
+      if (const auto* ground = dynamic_cast<const clothlab::Ground*>(effect.get())) {
+        out["ground"] = ground->y0();
+      } else if (const auto* plane = dynamic_cast<const clothlab::Plane*>(effect.get())) {
+        out["planes"].push_back({{"point", vec(plane->point())}, {"normal", vec(plane->normal())}});
+      } else if (const auto* sphere = dynamic_cast<const clothlab::Sphere*>(effect.get())) {
+        out["spheres"].push_back({{"centre", vec(sphere->centre())}, {"radius", sphere->radius()}});
+      }
+    }
+  }
+  colliders = out.dump();
+  return colliders.c_str();
+}
+
 // Advances by `frame_time` seconds of simulated time; returns the status (the steps taken are in
 // clothlab_steps()).
 EMSCRIPTEN_KEEPALIVE int clothlab_advance(double frame_time) {
   if (!g_simulation) return kFailed;
   return guarded([&] {
     g_simulation->advance(frame_time);
-    // A tear (lesson 06) changes the surface.
-    if (g_simulation->world().triangles.size() * 3 != g_triangles.size()) take_surface();
+    // A tear (lesson 06) changes the surface and the springs.
+    const clothlab::World& world = g_simulation->world();
+    const clothlab::SpringDampers* springs = clothlab::find_spring_effect(world, "springs");
+    if (world.triangles.size() * 3 != g_triangles.size() ||
+        (springs && springs->springs().size() * 2 != g_springs.size()))
+      take_surface();
   });
 }
 
@@ -278,6 +375,27 @@ EMSCRIPTEN_KEEPALIVE int clothlab_spring_count() {
 }
 EMSCRIPTEN_KEEPALIVE const int* clothlab_springs() {
   return g_springs.data();
+}
+
+// The strain of the cloth at each particle, for colouring it: of the springs that meet there,
+// the one stretched or squeezed most, as l / l0 - 1 (negative when squeezed).
+EMSCRIPTEN_KEEPALIVE const double* clothlab_strains() {
+  static std::vector<double> strain;
+  const clothlab::World& world = g_simulation->world();
+  const clothlab::Matrix3X& x = world.particles.x;
+  strain.assign(static_cast<size_t>(world.particles.size()), 0.0);
+  if (const clothlab::SpringDampers* family = clothlab::find_spring_effect(world, "springs")) {
+    const clothlab::SpringSet& s = family->springs();
+    for (size_t k = 0; k < s.size(); ++k) {
+      if (!(s.l0(k) > 0.0)) continue;  // a spring of no length has no strain to show
+      const double e = (x.col(s.j(k)) - x.col(s.i(k))).norm() / s.l0(k) - 1.0;
+      for (const Index end : {s.i(k), s.j(k)}) {
+        double& at = strain[static_cast<size_t>(end)];
+        if (std::abs(e) > std::abs(at)) at = e;
+      }
+    }
+  }
+  return strain.data();
 }
 
 // Whether particle i is pinned (by the scene, or held by the mouse).

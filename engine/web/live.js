@@ -40,6 +40,9 @@
       triangles: f('clothlab_triangles', 'number', []),
       springCount: f('clothlab_spring_count', 'number', []),
       springs: f('clothlab_springs', 'number', []),
+      strains: f('clothlab_strains', 'number', []),
+      method: f('clothlab_method', 'string', []),
+      colliders: f('clothlab_colliders', 'string', []),
       isPinned: f('clothlab_is_pinned', 'number', ['number']),
       grab: f('clothlab_grab', 'number', ['number']),
       drag: f('clothlab_drag', 'number', ['number', 'number', 'number', 'number']),
@@ -62,13 +65,23 @@
     return false;
   }
 
-  function positions() {
-    const n = api.particles();
-    return new Float64Array(module.HEAPF64.buffer, api.positions(), 3 * n);
+  // An engine as the renderer sees it (render.js): views into the module's memory, made anew
+  // at each call since the memory may grow.
+  function sourceOf(m, a) {
+    return {
+      count: () => a.particles(),
+      positions: () => new Float64Array(m.HEAPF64.buffer, a.positions(), 3 * a.particles()),
+      triangles: () => new Int32Array(m.HEAP32.buffer, a.triangles(), 3 * a.triangleCount()),
+      springs: () => new Int32Array(m.HEAP32.buffer, a.springs(), 2 * a.springCount()),
+      isPinned: (i) => a.isPinned(i),
+      strains: () => new Float64Array(m.HEAPF64.buffer, a.strains(), a.particles()),
+      colliders: () => JSON.parse(a.colliders()),
+    };
   }
+  let source = null;  // this page's engine, as sourceOf() gives it
 
-  function indices(pointer, count) {
-    return new Int32Array(module.HEAP32.buffer, pointer, count).slice();
+  function positions() {
+    return source.positions();
   }
 
   // --- Loading a scene --------------------------------------------------------------------
@@ -86,9 +99,14 @@
     energy.clear();
     buildSliders();
     readIntegrator();
-    view.rebuild(true);
+    twin.load(text, name);
+    rebuildView(false);
     setRunning(true);
     return true;
+  }
+
+  function rebuildView(keepCamera) {
+    view.rebuild(twin.on ? [source, twin.source] : [source], keepCamera);
   }
 
   // Changes the number at `path` to `value` and goes on with the motion.
@@ -107,7 +125,8 @@
     sceneText = text;
     $('editor').value = text;
     parameters = JSON.parse(api.parameters());
-    view.rebuild(false);
+    twin.reload(text, sceneName);
+    rebuildView(true);
     return true;
   }
 
@@ -179,17 +198,7 @@
 
   function readIntegrator() {
     $('dt').value = api.dt();
-    const method = /^\s*method\s*=\s*"([^"]*)"/m.exec(section(sceneText, 'integrator'));
-    $('integrator').value = method ? method[1] : 'symplectic-euler';
-  }
-
-  // The text of [table] in a scene, up to the next table.
-  function section(text, table) {
-    const header = new RegExp(`^[ \\t]*\\[${table}\\][^\\n]*$`, 'm').exec(text);
-    if (!header) return '';
-    const rest = text.slice(header.index + header[0].length);
-    const next = rest.search(/^[ \t]*\[/m);
-    return next < 0 ? rest : rest.slice(0, next);
+    $('integrator').value = api.method();
   }
 
   function setupControls() {
@@ -247,6 +256,7 @@
       const w = Math.min(1, taken / 500);
       stats.stepMs = stats.stepMs === 0 ? ms / taken : (1 - w) * stats.stepMs + w * (ms / taken);
     }
+    twin.advance(frameTime, status);
     if (!check(status)) return false;
     energy.add(api.time(), api.kinetic(), api.potential());
     return true;
@@ -289,244 +299,118 @@
   };
 
   // --- Drawing ----------------------------------------------------------------------------
-  const view = makeView();
+  const view = ClothlabRender.makeView($('canvas'), Array.from(document.querySelectorAll('.pane-label')));
 
-  function makeView() {
-    const canvas = $('canvas');
-    let renderer = null;
-    try {
-      renderer = new THREE.WebGLRenderer({ canvas, antialias: true });
-    } catch (e) {
-      renderer = null;
-    }
-    if (!renderer || !renderer.getContext()) return makeCanvasView(canvas);
-    renderer.shadowMap.enabled = true;
-    const scene = new THREE.Scene();
-    scene.background = new THREE.Color(0xdfe6ec);
-    const camera = new THREE.PerspectiveCamera(40, 1, 0.01, 1000);
-    const controls = new THREE.OrbitControls(camera, canvas);
-    controls.enableDamping = true;
-    scene.add(new THREE.HemisphereLight(0xffffff, 0x8899aa, 0.55));
-    const sun = new THREE.DirectionalLight(0xffffff, 0.75);
-    sun.castShadow = true;
-    sun.shadow.mapSize.set(1024, 1024);
-    scene.add(sun, sun.target);
+  function setupDisplay() {
+    const settings = view.settings;
+    $('strain').addEventListener('change', () => { settings.strain = $('strain').checked; view.update(); });
+    $('strain-scale').addEventListener('change', () => { settings.strainScale = Number($('strain-scale').value); view.update(); });
+    $('show-springs').addEventListener('change', () => { settings.springs = $('show-springs').checked; });
+  }
 
-    let geometry = null, front = null, back = null, lines = null, points = null, grid = null, floor = null;
-    let pinMarks = null, ball = null;
-    // Front and back of the cloth in different colours, both lit (two-sided lighting).
-    const frontMaterial = new THREE.MeshPhongMaterial({ color: 0xc8553d, side: THREE.FrontSide, shininess: 20 });
-    const backMaterial = new THREE.MeshPhongMaterial({ color: 0x3d7ec8, side: THREE.BackSide, shininess: 20 });
+  // --- Side by side with the reference ----------------------------------------------------
+  // A student page carries the reference build too (createClothlabReference). Side by side, it
+  // runs the same scene with the same slider changes, frame times and mouse, and the page marks
+  // the first frame where any particle of the student's cloth is farther than the tolerance
+  // from the reference's: the frame, its time, the particle and the distance. Frames are
+  // compared after each advance, on the positions drawn.
+  const twin = {
+    engine: null, api: null, source: null, on: false,
+    tolerance: 1e-9, frames: 0, worst: 0, first: null,
 
-    function clear() {
-      for (const o of [front, back, lines, points, grid, floor, pinMarks, ball]) if (o) scene.remove(o);
-      front = back = lines = points = grid = floor = pinMarks = ball = null;
-    }
-
-    function rebuild(frame) {
-      const n = api.particles();
-      const x = positions();
-      const keepCamera = !frame;
-      clear();
-      geometry = new THREE.BufferGeometry();
-      geometry.setAttribute('position', new THREE.BufferAttribute(new Float32Array(3 * n), 3));
-      const tris = api.triangleCount();
-      if (tris > 0) {
-        geometry.setIndex(new THREE.BufferAttribute(new Uint32Array(indices(api.triangles(), 3 * tris)), 1));
-        front = new THREE.Mesh(geometry, frontMaterial);
-        back = new THREE.Mesh(geometry, backMaterial);
-        front.castShadow = back.castShadow = true;
-        scene.add(front, back);
+    // Starts a second engine from `factory`, then runs it beside this page's from the start
+    // of the scene as it is now.
+    start(factory) {
+      const begin = (m) => {
+        this.engine = m;
+        this.api = bind(m);
+        this.source = sourceOf(m, this.api);
+        this.on = true;
+        load(sceneText, sceneName);
+      };
+      return this.engine ? Promise.resolve(begin(this.engine)) : factory().then(begin);
+    },
+    stop() {
+      this.on = false;
+      this.first = null;
+      rebuildView(true);
+      this.show();
+    },
+    load(text, name) {
+      this.frames = 0;
+      this.worst = 0;
+      this.first = null;
+      if (this.on && !this.mirror(this.api.load(text, name), 'read the scene')) return;
+      this.show();
+    },
+    reload(text, name) {
+      if (this.on) this.mirror(this.api.reload(text, name), 'read the scene again');
+    },
+    // The reference failing where the student's code did not is worth saying (a scene that
+    // blows up does so in both).
+    mirror(status, what) {
+      if (status === 0 || this.first) return status === 0;
+      this.first = { frame: this.frames, time: api.time(), text: `the reference could not ${what}: ${this.api.message()}` };
+      this.show();
+      return false;
+    },
+    advance(frameTime, status) {
+      if (!this.on) return;
+      const twinStatus = this.api.advance(frameTime);
+      this.frames += 1;
+      if (this.first) return;
+      if (status !== 0 || twinStatus !== 0) {
+        this.first = {
+          frame: this.frames, time: api.time(),
+          text: status !== 0 ? `your code stopped (${kStatus[status]}): ${api.message()}`
+                             : `the reference stopped (${kStatus[twinStatus]}): ${this.api.message()}`,
+        };
       } else {
-        const springs = api.springCount();
-        if (springs > 0) {
-          const lineGeometry = new THREE.BufferGeometry();
-          lineGeometry.setAttribute('position', geometry.getAttribute('position'));
-          lineGeometry.setIndex(new THREE.BufferAttribute(new Uint32Array(indices(api.springs(), 2 * springs)), 1));
-          lines = new THREE.LineSegments(lineGeometry, new THREE.LineBasicMaterial({ color: 0x333333 }));
-          scene.add(lines);
+        const a = source.positions(), b = this.source.positions();
+        let worst = a.length === b.length ? 0 : Infinity, at = -1;
+        for (let k = 0; k < Math.min(a.length, b.length); ++k) {
+          const d = Math.abs(a[k] - b[k]);
+          if (d > worst) { worst = d; at = Math.floor(k / 3); }
         }
-        points = new THREE.Points(geometry, new THREE.PointsMaterial({ color: 0xc8553d, size: 6, sizeAttenuation: false }));
-        scene.add(points);
-      }
-      // Pins, and the particle the mouse holds, as dots.
-      pinMarks = new THREE.Points(new THREE.BufferGeometry(), new THREE.PointsMaterial({ color: 0x111111, size: 7, sizeAttenuation: false }));
-      scene.add(pinMarks);
-      // The ground: from [ground] y, else below the scene.
-      const box = bounds(x);
-      const groundY = groundHeight(box);
-      const size = Math.max(box.size, 1e-3);
-      grid = new THREE.GridHelper(size * 4, 20, 0x888888, 0xbbbbbb);
-      grid.position.set(box.centre[0], groundY, box.centre[2]);
-      floor = new THREE.Mesh(new THREE.PlaneGeometry(size * 4, size * 4), new THREE.ShadowMaterial({ opacity: 0.25 }));
-      floor.rotation.x = -Math.PI / 2;
-      floor.position.set(box.centre[0], groundY + size * 1e-3, box.centre[2]);
-      floor.receiveShadow = true;
-      scene.add(grid, floor);
-      // A [sphere] collider, a little smaller than it is so that the cloth on it shows.
-      const value = (name) => (parameters.find((q) => q.name === name) || {}).value;
-      const radius = value('sphere.radius');
-      if (radius > 0) {
-        ball = new THREE.Mesh(new THREE.SphereGeometry(0.98 * radius, 48, 24),
-                              new THREE.MeshPhongMaterial({ color: 0x9aa3ab }));
-        ball.position.set(value('sphere.centre[0]') || 0, value('sphere.centre[1]') || 0,
-                          value('sphere.centre[2]') || 0);
-        ball.castShadow = ball.receiveShadow = true;
-        scene.add(ball);
-      }
-      sun.position.set(box.centre[0] + size, box.centre[1] + 3 * size, box.centre[2] + 2 * size);
-      sun.target.position.set(box.centre[0], groundY, box.centre[2]);
-      const cam = sun.shadow.camera;
-      cam.left = cam.bottom = -2 * size;
-      cam.right = cam.top = 2 * size;
-      cam.near = 0.01 * size;
-      cam.far = 10 * size;
-      cam.updateProjectionMatrix();
-      if (!keepCamera) {
-        controls.target.set(box.centre[0], box.centre[1], box.centre[2]);
-        camera.position.set(box.centre[0] + 0.6 * size, box.centre[1] + 0.5 * size, box.centre[2] + 2.2 * size);
-        camera.near = size * 1e-3;
-        camera.far = size * 1e3;
-        camera.updateProjectionMatrix();
-      }
-      update();
-    }
-
-    function update() {
-      if (!geometry) return;
-      const x = positions();
-      const attribute = geometry.getAttribute('position');
-      attribute.array.set(x);
-      attribute.needsUpdate = true;
-      if (front) geometry.computeVertexNormals();
-      geometry.computeBoundingSphere();
-      const pins = [];
-      const n = api.particles();
-      for (let i = 0; i < n; ++i) if (api.isPinned(i)) pins.push(x[3 * i], x[3 * i + 1], x[3 * i + 2]);
-      pinMarks.geometry.setAttribute('position', new THREE.BufferAttribute(new Float32Array(pins), 3));
-    }
-
-    function draw() {
-      const w = canvas.clientWidth, h = canvas.clientHeight;
-      if (canvas.width !== w || canvas.height !== h) {
-        renderer.setSize(w, h, false);
-        camera.aspect = w / Math.max(h, 1);
-        camera.updateProjectionMatrix();
-      }
-      controls.update();
-      renderer.render(scene, camera);
-    }
-
-    // The particle nearest the ray under the mouse (within a few pixels), or -1.
-    function pick(clientX, clientY) {
-      const rect = canvas.getBoundingClientRect();
-      const x = positions();
-      let best = -1, bestDistance = 12;  // [px]
-      const p = new THREE.Vector3();
-      for (let i = 0; i < api.particles(); ++i) {
-        p.set(x[3 * i], x[3 * i + 1], x[3 * i + 2]).project(camera);
-        const sx = rect.left + (p.x + 1) / 2 * rect.width, sy = rect.top + (1 - p.y) / 2 * rect.height;
-        const d = Math.hypot(sx - clientX, sy - clientY);
-        if (d < bestDistance) { bestDistance = d; best = i; }
-      }
-      return best;
-    }
-
-    // Where the mouse points on the plane through `point` facing the camera.
-    function pointOnPlane(clientX, clientY, point) {
-      const rect = canvas.getBoundingClientRect();
-      const ndc = new THREE.Vector2((clientX - rect.left) / rect.width * 2 - 1, -(clientY - rect.top) / rect.height * 2 + 1);
-      const ray = new THREE.Raycaster();
-      ray.setFromCamera(ndc, camera);
-      const normal = new THREE.Vector3();
-      camera.getWorldDirection(normal);
-      const plane = new THREE.Plane().setFromNormalAndCoplanarPoint(normal, new THREE.Vector3(...point));
-      const hit = new THREE.Vector3();
-      return ray.ray.intersectPlane(plane, hit) ? [hit.x, hit.y, hit.z] : null;
-    }
-
-    // Where particle i is on the screen [px].
-    function screenOf(i) {
-      const x = positions();
-      const p = new THREE.Vector3(x[3 * i], x[3 * i + 1], x[3 * i + 2]).project(camera);
-      const rect = canvas.getBoundingClientRect();
-      return [rect.left + (p.x + 1) / 2 * rect.width, rect.top + (1 - p.y) / 2 * rect.height];
-    }
-
-    return { kind: 'webgl', rebuild, update, draw, pick, pointOnPlane, screenOf, controls };
-  }
-
-  // Without WebGL: the particles and springs drawn flat on a 2D canvas, seen from the front.
-  function makeCanvasView(canvas) {
-    const g = canvas.getContext('2d');
-    let box = null;
-    const screen = (x, i) => {
-      const w = canvas.width, h = canvas.height, s = 0.8 * Math.min(w, h) / Math.max(box.size, 1e-9);
-      return [w / 2 + s * (x[3 * i] - box.centre[0]), h / 2 - s * (x[3 * i + 1] - box.centre[1])];
-    };
-    return {
-      kind: '2d',
-      rebuild() { box = bounds(positions()); },
-      update() {},
-      draw() {
-        canvas.width = canvas.clientWidth;
-        canvas.height = canvas.clientHeight;
-        const x = positions();
-        g.clearRect(0, 0, canvas.width, canvas.height);
-        const tris = indices(api.triangles(), 3 * api.triangleCount());
-        g.strokeStyle = '#c8553d';
-        g.beginPath();
-        for (let k = 0; k < tris.length; k += 3) {
-          const a = screen(x, tris[k]), b = screen(x, tris[k + 1]), c = screen(x, tris[k + 2]);
-          g.moveTo(...a); g.lineTo(...b); g.lineTo(...c); g.closePath();
+        this.worst = Math.max(this.worst, worst);
+        if (worst > this.tolerance) {
+          this.first = {
+            frame: this.frames, time: api.time(), particle: at, distance: worst,
+            text: `particle ${at} is ${formatValue(worst)} m from where the reference has it ` +
+                  `(in x, y or z; the tolerance is ${formatValue(this.tolerance)} m)`,
+          };
+          setRunning(false);  // stay on the frame that differs
         }
-        g.stroke();
-        g.fillStyle = '#222';
-        for (let i = 0; i < api.particles(); ++i) g.fillRect(...screen(x, i).map((v) => v - 1.5), 3, 3);
-      },
-      pick(clientX, clientY) {
-        const x = positions();
-        let best = -1, bestDistance = 12;
-        for (let i = 0; i < api.particles(); ++i) {
-          const [sx, sy] = this.screenOf(i, x);
-          const d = Math.hypot(sx - clientX, sy - clientY);
-          if (d < bestDistance) { bestDistance = d; best = i; }
-        }
-        return best;
-      },
-      screenOf(i, x = positions()) {
-        const rect = canvas.getBoundingClientRect();
-        const [sx, sy] = screen(x, i);
-        return [rect.left + sx, rect.top + sy];
-      },
-      pointOnPlane(clientX, clientY, point) {
-        const rect = canvas.getBoundingClientRect();
-        const s = 0.8 * Math.min(canvas.width, canvas.height) / Math.max(box.size, 1e-9);
-        return [box.centre[0] + (clientX - rect.left - canvas.width / 2) / s,
-                box.centre[1] - (clientY - rect.top - canvas.height / 2) / s, point[2]];
-      },
-      controls: null,
-    };
-  }
-
-  function bounds(x) {
-    const lo = [Infinity, Infinity, Infinity], hi = [-Infinity, -Infinity, -Infinity];
-    for (let i = 0; i < x.length; i += 3) {
-      for (let a = 0; a < 3; ++a) {
-        lo[a] = Math.min(lo[a], x[i + a]);
-        hi[a] = Math.max(hi[a], x[i + a]);
       }
-    }
-    if (x.length === 0) return { centre: [0, 0, 0], size: 1, lo: [0, 0, 0], hi: [0, 0, 0] };
-    const size = Math.max(hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2], 0.1);
-    return { centre: lo.map((l, a) => (l + hi[a]) / 2), size, lo, hi };
-  }
+      this.show();
+    },
+    show() {
+      const box = $('compare-result');
+      if (!box) return;
+      if (!this.on) {
+        box.textContent = '';
+        return;
+      }
+      box.className = this.first ? 'differs' : 'same';
+      box.textContent = this.first
+        ? `First difference at frame ${this.first.frame} (t = ${this.first.time.toFixed(4)} s): ${this.first.text}`
+        : `${this.frames} frames alike (largest difference ${formatValue(this.worst)} m)`;
+    },
+  };
 
-  function groundHeight(box) {
-    const y = parameters.find((p) => p.name === 'ground.y');
-    if (y) return y.value;
-    if (/^\s*\[ground\]/m.test(sceneText)) return 0;
-    return box.lo[1] - 0.5 * box.size;
+  function setupCompare() {
+    const factory = typeof createClothlabReference === 'function' ? createClothlabReference : null;
+    $('compare-box').style.display = factory ? '' : 'none';
+    if (!factory) return;
+    $('compare-tolerance').value = twin.tolerance;
+    $('compare-tolerance').addEventListener('change', () => {
+      const tolerance = Number($('compare-tolerance').value);
+      if (tolerance >= 0) twin.tolerance = tolerance;
+    });
+    $('compare').addEventListener('change', () => {
+      if ($('compare').checked) twin.start(factory);
+      else twin.stop();
+    });
   }
 
   // --- The mouse --------------------------------------------------------------------------
@@ -536,6 +420,7 @@
     const i = view.pick(clientX, clientY);
     if (i < 0) return -1;
     if (!check(api.grab(i))) return -1;
+    if (twin.on) twin.api.grab(i);
     drag.particle = i;
     if (view.controls) view.controls.enabled = false;
     return i;
@@ -546,12 +431,15 @@
     const x = positions();
     const i = drag.particle;
     const target = view.pointOnPlane(clientX, clientY, [x[3 * i], x[3 * i + 1], x[3 * i + 2]]);
-    if (target) check(api.drag(i, ...target));
+    if (!target) return;
+    check(api.drag(i, ...target));
+    if (twin.on) twin.api.drag(i, ...target);
   }
 
   function release() {
     if (drag.particle < 0) return;
     api.release(drag.particle);
+    if (twin.on) twin.api.release(drag.particle);
     drag.particle = -1;
     if (view.controls) view.controls.enabled = true;
   }
@@ -590,10 +478,13 @@
   createClothlab().then((m) => {
     module = m;
     api = bind(m);
+    source = sourceOf(m, api);
     $('title').textContent = lesson.title;
     $('build').textContent = lesson.kernels === 'solutions'
       ? 'the reference solutions' : 'your exercises (exercises/)';
     setupControls();
+    setupDisplay();
+    setupCompare();
     setupMouse();
     // The address may name the scene and a time to start from: page.html#scene=flag.toml&t=2.
     const wish = new URLSearchParams(location.hash.slice(1));
@@ -607,10 +498,11 @@
     window.clothlabPage = {
       lesson, api, load, setParameter, advance, grabAt, dragTo, release,
       positions: () => Array.from(positions()),
+      strains: () => Array.from(source.strains()),
       message: () => $('message').textContent,
       parameters: () => parameters,
       sceneText: () => sceneText,
-      setRunning, view,
+      setRunning, view, twin,
       ready: true,
     };
     document.dispatchEvent(new Event('clothlab-ready'));

@@ -1,6 +1,7 @@
 #!/usr/bin/env python3
-"""Writes one lesson's live page: the shell page.html with three.js, the engine module, the
-page's script and the lesson's scenes put in place of its markers. The result is one file that
+"""Writes one lesson's live page: the shell page.html with three.js, the engine module (and, on
+a student page, the reference module), the renderer, the page's script and the lesson's scenes
+put in place of its markers. The result is one file that
 needs no network and opens from file://."""
 
 import argparse
@@ -33,8 +34,11 @@ def html_escape(text: str) -> str:
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__)
-    for option in ("lesson", "shell", "script", "three", "orbit", "module", "out", "kernels"):
+    for option in ("lesson", "shell", "script", "render", "three", "orbit", "module", "out",
+                   "kernels"):
         parser.add_argument(f"--{option}", required=True)
+    parser.add_argument("--reference", help="the reference module, for a student page's "
+                        "side-by-side mode (its factory is createClothlabReference)")
     args = parser.parse_args()
 
     lesson = pathlib.Path(args.lesson)
@@ -59,6 +63,10 @@ def main() -> None:
                                      "</script>\n<script>" +
                                      script_text(pathlib.Path(args.orbit)) + "</script>",
         "<!--CLOTHLAB_MODULE-->": "<script>" + script_text(pathlib.Path(args.module)) +
+                                  "</script>",
+        "<!--CLOTHLAB_REFERENCE-->": ("<script>" + script_text(pathlib.Path(args.reference)) +
+                                      "</script>") if args.reference else "",
+        "<!--CLOTHLAB_RENDER-->": "<script>" + script_text(pathlib.Path(args.render)) +
                                   "</script>",
         "<!--CLOTHLAB_SCRIPT-->": "<script>" + script_text(pathlib.Path(args.script)) +
                                   "</script>",

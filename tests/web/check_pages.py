@@ -1,8 +1,11 @@
 #!/usr/bin/env python3
 """Opens each live lesson page in headless Chromium with page_test.js put into a copy of it, and
 checks what the test found: no console error, time advances in every scene, a slider changes
-the motion, a drag moves the grabbed particle, an edited scene's error shows FILE:LINE:COL (and,
-on a student page built on the stubs, the exercise's message)."""
+the motion, a drag moves the grabbed particle, an edited scene's error shows FILE:LINE:COL, the
+strain at each particle comes from the engine, a slider keeps a cloth's tears, the engine names
+its planes, and side by side the same build never differs while a particle moved in one alone is
+the first difference (and, on a student page built on the stubs, the exercise's message, and the
+frame where the stub stops as the first difference from the reference)."""
 
 import argparse
 import base64

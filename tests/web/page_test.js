@@ -15,7 +15,7 @@
     console.log('CLOTHLAB-TEST ' + btoa(binary));
   };
 
-  function run() {
+  async function run() {
     const page = window.clothlabPage;
     const api = page.api;
     const student = page.lesson.kernels !== 'solutions';
@@ -28,6 +28,17 @@
       page.advance(0.05);
       const message = page.message();
       say('a stub shows its exercise', /exercise|ex\d\d/i.test(message) && /lesson/i.test(message), message);
+      // Side by side with the reference: the first frame is where the stub stops.
+      await page.twin.start(createClothlabReference);
+      page.setRunning(false);
+      page.advance(1 / 60);
+      const stop = page.twin.first;
+      say('side by side, the first difference is the frame where the stub stops',
+          stop && stop.frame === 1 && /your code stopped/.test(stop.text) && /ex\d\d/.test(stop.text),
+          JSON.stringify(stop));
+      for (let k = 0; k < 600 && page.twin.api.steps() === 0; ++k) page.advance(1 / 60);
+      say('side by side, the reference runs on', page.twin.api.time() > 0 && page.twin.api.steps() > 0,
+          `t = ${page.twin.api.time()}`);
       return;
     }
 
@@ -102,6 +113,71 @@
       say('a released particle is free again', !api.isPinned(grabbed), grabbed);
     }
 
+    // Side by side: the same build twice never differs; a particle moved in one of them alone
+    // is the first difference, at the frame it moved.
+    page.load(first.text, first.name);
+    await page.twin.start(createClothlab);
+    page.setRunning(false);
+    for (let k = 0; k < 6; ++k) page.advance(1 / 60);
+    say('side by side, the same code runs alike', !page.twin.first && page.twin.worst === 0 && page.twin.frames === 6,
+        `${JSON.stringify(page.twin.first)} worst ${page.twin.worst} after ${page.twin.frames} frames`);
+    // Particle i pulled dx along x over one frame, in this page's engine alone.
+    const pull = (i, dx) => {
+      const x = page.positions();
+      api.grab(i);
+      api.drag(i, x[3 * i] + dx, x[3 * i + 1], x[3 * i + 2]);
+      page.advance(1 / 60);
+      api.release(i);
+    };
+    if (free >= 0) {
+      pull(free, 0.01);
+      const difference = page.twin.first || {};
+      say('side by side, a particle moved in one build is the first difference, at its frame',
+          difference.frame === 7 && difference.particle === free && difference.distance > 1e-3,
+          JSON.stringify(difference));
+    }
+    page.twin.stop();
+
+    // Colour by strain: the engine's strain at each particle, and drawing with it.
+    page.load(first.text, first.name);
+    page.setRunning(false);
+    // A particle pulled 5 cm away from its neighbours stretches their springs.
+    if (free >= 0) pull(free, 0.05);
+    page.view.settings.strain = true;
+    page.view.settings.springs = true;
+    page.view.update();
+    page.view.draw();
+    const strains = page.strains();
+    const largest = Math.max(...strains.map(Math.abs));
+    say('colour by strain: the strain at each particle, from the engine', strains.length === api.particles() &&
+        strains.every(Number.isFinite) && (api.springCount() === 0 || largest > 0), `largest |strain| ${largest}`);
+    page.view.settings.strain = false;
+    page.view.settings.springs = false;
+
+    // A torn cloth stays torn when a slider reads its scene again (lesson 06).
+    for (const scene of page.lesson.scenes) {
+      if (!/^\s*\[tearing\]/m.test(scene.text)) continue;
+      page.load(scene.text, scene.name);
+      page.setRunning(false);
+      const before = api.springCount();
+      for (let k = 0; k < 600 && api.springCount() === before && !page.message(); ++k) page.advance(1 / 60);
+      const torn = api.springCount(), triangles = api.triangleCount();
+      if (torn === before) continue;
+      const slider = page.parameters().find((q) => /^(springs|damping|gravity|aerodynamics)\./.test(q.name) && !q.integer);
+      page.setParameter(slider.name, slider.value * 1.01);
+      say(`${scene.name}: a slider keeps the tears (${before - torn} springs torn)`,
+          api.springCount() === torn && api.triangleCount() === triangles,
+          `springs ${before} -> ${torn} -> ${api.springCount()}, triangles ${triangles} -> ${api.triangleCount()}`);
+    }
+
+    // The engine's colliders are drawn: a [[plane]] scene has its plane.
+    for (const scene of page.lesson.scenes) {
+      if (!/^\s*\[\[plane\]\]/m.test(scene.text)) continue;
+      page.load(scene.text, scene.name);
+      const colliders = JSON.parse(api.colliders());
+      say(`${scene.name}: the engine names its planes for drawing`, colliders.planes.length > 0, JSON.stringify(colliders));
+    }
+
     // An edited scene with an error shows FILE:LINE:COL.
     const lines = first.text.split('\n').length;
     page.load(first.text + (first.text.endsWith('\n') ? '' : '\n') + 'mistake = 1\n', first.name);
@@ -110,9 +186,9 @@
         `${page.message()} (expected ${expected})`);
   }
 
-  function start() {
+  async function start() {
     try {
-      run();
+      await run();
     } catch (e) {
       say('the test ran', false, `${e}\n${e.stack}`);
     }

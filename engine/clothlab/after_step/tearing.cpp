@@ -24,11 +24,15 @@ void Tearing::apply(World& world, double /*dt*/) {
   // cannot leave a chosen spring in the cloth while its triangles go.
   std::sort(torn.begin(), torn.end());
   torn.erase(std::unique(torn.begin(), torn.end()), torn.end());
+  tear(world, torn);
+}
 
+void Tearing::tear(World& world, const std::vector<size_t>& torn) {
+  SpringSet& s = springs_.springs();
   // The torn edges, then every triangle that had one of them as a side.
   std::set<std::pair<Index, Index>> gone;
   for (size_t k : torn)
-    gone.insert(ends[k]);
+    gone.insert({std::min(s.i(k), s.j(k)), std::max(s.i(k), s.j(k))});
   s.erase(torn);
   torn_ += static_cast<long>(torn.size());
   const auto has_torn_edge = [&](const Triangle& t) {

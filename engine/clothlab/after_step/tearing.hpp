@@ -40,6 +40,10 @@ class Tearing final : public PostStepEffect {
         max_tears_(max_tears) {}
   std::string_view name() const override { return "tearing"; }
   void apply(World& world, double dt) override;
+  // Tears the springs at `positions` (ascending, once each) in `springs`, with what goes with
+  // them: what apply() does with the springs select_tears() chose. (A page that reads its scene
+  // again tears the new cloth where the old one had torn.)
+  void tear(World& world, const std::vector<size_t>& positions);
   long torn() const { return torn_; }  // springs torn so far
 
  private:
