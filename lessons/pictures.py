@@ -1,6 +1,8 @@
 #!/usr/bin/env python3
 """Renders the picture at the top of each lesson: its scene, run by clothlab, drawn by the
-viewer page in headless Chromium, saved as lessons/NN-name/picture.png.
+viewer page in headless Chromium, saved as lessons/NN-name/picture.png. The browser is given
+no WebGL, so the page draws on its 2D canvas: the pictures stay the same whether or not the
+build put three.js in the page (each lesson's live.png shows the WebGL drawing).
 
     cmake --build build --target pictures      (or: python3 lessons/pictures.py build/clothlab)
     python3 lessons/pictures.py build/clothlab 09-ropes-and-solids     (only the lessons named)
@@ -52,7 +54,8 @@ def main():
             picture = os.path.join(lessons, lesson, "picture.png")
             shown = 10**6 if frame < 0 else frame  # the viewer clamps to the last frame
             subprocess.run(
-                [browser, "--headless", "--no-sandbox", "--disable-gpu", "--disable-quic",
+                [browser, "--headless", "--no-sandbox", "--disable-gpu", "--disable-3d-apis",
+                 "--disable-quic",
                  "--no-first-run", "--disable-background-networking",
                  "--disable-component-update", "--disable-sync",
                  f"--user-data-dir={os.path.join(work, 'profile')}", "--window-size=720,420",

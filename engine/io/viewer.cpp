@@ -189,6 +189,27 @@ std::string ViewerRecorder::sampling_note() const {
                      offered_, why);
 }
 
+namespace {
+
+// Calls visit(set, k, structural) for each spring of each spring family of `world` in turn,
+// with a comma put between them: structural for the family "springs", not for "bending".
+template <typename Visit>
+void put_springs(PageFile& file, const World& world, Visit visit) {
+  bool first = true;
+  for (const auto& effect : world.force_effects) {
+    if (const auto* family = dynamic_cast<const SpringDampers*>(effect.get())) {
+      const bool structural = family->name() == "springs";
+      for (size_t k = 0; k < family->springs().size(); ++k) {
+        if (!first) file.put(",");
+        first = false;
+        visit(family->springs(), k, structural);
+      }
+    }
+  }
+}
+
+}  // namespace
+
 void ViewerRecorder::write(const World& world, const std::filesystem::path& html) const {
   // The frames of the page: those kept, then the last one offered if it is not among them.
   std::vector<const Frame*> frames;
@@ -274,20 +295,19 @@ void ViewerRecorder::write(const World& world, const std::filesystem::path& html
     }
     file.put("]");
     file.put(",\"springs\":[");
-    bool first = true;
-    for (const auto& effect : world.force_effects) {
-      if (const auto* s = dynamic_cast<const SpringDampers*>(effect.get())) {
-        for (size_t k = 0; k < s->springs().size(); ++k) {
-          if (!first) file.put(",");
-          first = false;
-          file.put(s->springs().i(k));
-          file.put(",");
-          file.put(s->springs().j(k));
-        }
-      }
-    }
+    put_springs(file, world, [&](const SpringSet& s, size_t k, bool) {
+      file.put(s.i(k));
+      file.put(",");
+      file.put(s.j(k));
+    });
+    // Each spring's rest length, for colouring the cloth by strain: null for a spring the
+    // colours leave out (the bending springs, squeezed by every fold).
+    file.put("],\"rest\":[");
+    put_springs(file, world, [&](const SpringSet& s, size_t k, bool structural) {
+      file.put(structural ? fmt::format("{}", s.l0(k)) : std::string("null"));
+    });
     file.put("],\"pins\":[");
-    first = true;
+    bool first = true;
     for (Index i = 0; i < world.particles.size(); ++i) {
       if (world.particles.inv_m[i] != 0.0) continue;
       if (!first) file.put(",");

@@ -5,7 +5,9 @@
 //     isPinned(i), strains() (one number a particle: l / l0 - 1), colliders() }
 //
 // where colliders() is { ground: height or null, planes: [{point, normal}],
-// spheres: [{centre, radius}] } as the engine has them. With two sources the canvas is split
+// spheres: [{centre, radius}] } as the engine has them. A source may also give bounds() (the box
+// the camera frames, else the first positions') and trails() (the positions so far, frame by
+// frame, for drawing each particle's path; the recorded-run viewer, engine/io/viewer.html). With two sources the canvas is split
 // in two panes under one camera: the left pane shows the first source, the right the second.
 'use strict';
 
@@ -80,6 +82,7 @@ const ClothlabRender = (function () {
       springs: new THREE.LineBasicMaterial({ color: 0x333333 }),
       points: new THREE.PointsMaterial({ color: 0xc8553d, size: 6, sizeAttenuation: false }),
       pins: new THREE.PointsMaterial({ color: 0x111111, size: 7, sizeAttenuation: false }),
+      trail: new THREE.LineBasicMaterial({ color: 0x1f4e79, transparent: true, opacity: 0.5 }),
       solid: new THREE.MeshPhongMaterial({ color: 0x9aa3ab }),
       plane: new THREE.MeshPhongMaterial({ color: 0x9aa3ab, side: THREE.DoubleSide, transparent: true, opacity: 0.55 }),
     };
@@ -104,6 +107,11 @@ const ClothlabRender = (function () {
       // Pins, and the particle the mouse holds, as dots.
       body.pins = new THREE.Points(new THREE.BufferGeometry(), materials.pins);
       body.objects = [body.front, body.back, body.lines, body.points, body.pins];
+      if (source.trails) {
+        body.trails = [];
+        for (let i = 0; i < n; ++i) body.trails.push(new THREE.Line(new THREE.BufferGeometry(), materials.trail));
+        body.objects.push(...body.trails);
+      }
       scene.add(...body.objects);
       topology(body);
       return body;
@@ -130,6 +138,7 @@ const ClothlabRender = (function () {
       body.lines.visible = on && (!cloth || settings.springs);
       body.points.visible = on && !cloth;
       body.pins.visible = on;
+      for (const trail of body.trails || []) trail.visible = on;
     }
 
     function clear() {
@@ -143,8 +152,7 @@ const ClothlabRender = (function () {
       clear();
       sources = list;
       bodies = list.map(makeBody);
-      const x = list[0].positions();
-      const box = bounds(x);
+      const box = list[0].bounds ? list[0].bounds() : bounds(list[0].positions());
       const colliders = list[0].colliders();
       const groundY = colliders.ground !== null && colliders.ground !== undefined
         ? colliders.ground : box.lo[1] - 0.5 * box.size;
@@ -213,6 +221,14 @@ const ClothlabRender = (function () {
         const pins = [];
         for (let i = 0; i < x.length / 3; ++i) if (body.source.isPinned(i)) pins.push(x[3 * i], x[3 * i + 1], x[3 * i + 2]);
         body.pins.geometry.setAttribute('position', new THREE.BufferAttribute(new Float32Array(pins), 3));
+        if (body.trails) {
+          const history = body.source.trails();
+          body.trails.forEach((trail, i) => {
+            const path = new Float32Array(3 * history.length);
+            history.forEach((frame, f) => path.set(frame.subarray(3 * i, 3 * i + 3), 3 * f));
+            trail.geometry.setAttribute('position', new THREE.BufferAttribute(path, 3));
+          });
+        }
       }
     }
 

@@ -4,6 +4,9 @@
   1. The cloth is drawn: the picture of the first frame is not a blank canvas.
   2. It moves: a later frame's picture differs from the first.
 
+Both on the 2D canvas (a browser without WebGL) and, with --webgl (the build put three.js in the
+page), with WebGL through the live pages' renderer, which the page must then say it uses.
+
 Exit 0 when both hold, 1 when one fails, 77 (ctest's "skipped") when no Chromium is installed,
 unless CLOTHLAB_REQUIRE_BROWSER=1 (as in CI), which makes a missing browser a failure.
 """
@@ -17,6 +20,10 @@ import tempfile
 import zlib
 
 BACKGROUND = (0xF4, 0xF4, 0xF1)  # the page's background colour, viewer.html
+WEBGL_BACKGROUND = (0xDF, 0xE6, 0xEC)  # the renderer's, engine/web/render.js
+# Chromium with WebGL on the CPU (SwiftShader), or with no GPU and so no WebGL.
+WEBGL = ["--use-angle=swiftshader", "--enable-unsafe-swiftshader"]
+NO_WEBGL = ["--disable-gpu", "--disable-3d-apis"]
 WIDTH, HEIGHT = 800, 600
 BAR = 64  # the control bar at the bottom of the page [px]
 
@@ -63,15 +70,48 @@ def read_png(path):
     return width, height, rows
 
 
-def screenshot(browser, page, frame, out, profile):
+def browser_command(browser, profile, flags):
+    return [browser, "--headless", "--no-sandbox", *flags, "--disable-quic", "--no-first-run",
+            "--disable-background-networking", "--disable-component-update", "--disable-sync",
+            f"--user-data-dir={profile}", f"--window-size={WIDTH},{HEIGHT}", "--hide-scrollbars",
+            "--virtual-time-budget=3000"]
+
+
+def screenshot(browser, page, frame, out, profile, flags):
     subprocess.run(
-        [browser, "--headless", "--no-sandbox", "--disable-gpu", "--disable-quic",
-         "--no-first-run", "--disable-background-networking", "--disable-component-update",
-         "--disable-sync", f"--user-data-dir={profile}", f"--window-size={WIDTH},{HEIGHT}",
-         "--hide-scrollbars", "--virtual-time-budget=3000", f"--screenshot={out}",
-         f"file://{os.path.abspath(page)}?frame={frame}"],
+        browser_command(browser, profile, flags) +
+        [f"--screenshot={out}", f"file://{os.path.abspath(page)}?frame={frame}"],
         check=True, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, timeout=120)
     return read_png(out)
+
+
+def renderer_of(browser, page, profile, flags):
+    """What the page says it draws with: "webgl", or "2d" when it says nothing."""
+    dom = subprocess.run(
+        browser_command(browser, profile, flags) + ["--dump-dom", f"file://{os.path.abspath(page)}?frame=0"],
+        check=True, capture_output=True, text=True, timeout=120).stdout
+    return "webgl" if 'data-renderer="webgl"' in dom else "2d"
+
+
+def check_pictures(first, later, background, what):
+    def far_from(pixel, ref):
+        return sum(abs(p - r) for p, r in zip(pixel, ref)) > 40
+
+    width, height, rows = first
+    view = [(x, y) for y in range(0, height - BAR, 2) for x in range(0, width, 2)]
+    drawn = sum(far_from(rows[y][x], background) for x, y in view)
+    changed = sum(far_from(rows[y][x], later[2][y][x]) for x, y in view)
+    share_drawn, share_changed = drawn / len(view), changed / len(view)
+    print(f"{what}: first frame: {100 * share_drawn:.1f} % of the view is drawn; "
+          f"last frame differs from it in {100 * share_changed:.1f} % of the view")
+    ok = True
+    if share_drawn < 0.02:
+        print(f"FAIL: {what}: the first frame looks blank: the cloth was not drawn")
+        ok = False
+    if share_changed < 0.01:
+        print(f"FAIL: {what}: the last frame looks like the first: nothing moved on screen")
+        ok = False
+    return ok
 
 
 def main():
@@ -79,6 +119,8 @@ def main():
     parser.add_argument("--clothlab", required=True)
     parser.add_argument("--scene", required=True)
     parser.add_argument("--work", required=True)
+    parser.add_argument("--webgl", action="store_true",
+                        help="the page carries three.js: check its WebGL drawing too")
     args = parser.parse_args()
 
     browser = shutil.which("chromium") or shutil.which("chromium-browser")
@@ -92,29 +134,23 @@ def main():
     subprocess.run([args.clothlab, "run", args.scene, "--out", run, "--html", page],
                    check=True, stdout=subprocess.DEVNULL)
     profile = tempfile.mkdtemp(prefix="clothlab-chromium-")
+    ok = True
     try:
-        first = screenshot(browser, page, 0, os.path.join(args.work, "first.png"), profile)
-        later = screenshot(browser, page, 10**6, os.path.join(args.work, "last.png"), profile)
+        passes = [("2D canvas", NO_WEBGL, BACKGROUND, "2d")]
+        if args.webgl:
+            passes.append(("WebGL", WEBGL, WEBGL_BACKGROUND, "webgl"))
+        for what, flags, background, expected in passes:
+            renderer = renderer_of(browser, page, profile, flags)
+            if renderer != expected:
+                print(f"FAIL: {what}: the page draws with {renderer}, not {expected}")
+                ok = False
+                continue
+            stem = os.path.join(args.work, expected)
+            first = screenshot(browser, page, 0, stem + "-first.png", profile, flags)
+            later = screenshot(browser, page, 10**6, stem + "-last.png", profile, flags)
+            ok = check_pictures(first, later, background, what) and ok
     finally:
         shutil.rmtree(profile, ignore_errors=True)
-
-    def far_from(pixel, ref):
-        return sum(abs(p - r) for p, r in zip(pixel, ref)) > 40
-
-    width, height, rows = first
-    view = [(x, y) for y in range(0, height - BAR, 2) for x in range(0, width, 2)]
-    drawn = sum(far_from(rows[y][x], BACKGROUND) for x, y in view)
-    changed = sum(far_from(rows[y][x], later[2][y][x]) for x, y in view)
-    share_drawn, share_changed = drawn / len(view), changed / len(view)
-    print(f"first frame: {100 * share_drawn:.1f} % of the view is drawn; "
-          f"last frame differs from it in {100 * share_changed:.1f} % of the view")
-    ok = True
-    if share_drawn < 0.02:
-        print("FAIL: the first frame looks blank: the cloth was not drawn")
-        ok = False
-    if share_changed < 0.01:
-        print("FAIL: the last frame looks like the first: nothing moved on screen")
-        ok = False
     return 0 if ok else 1
 
 
