@@ -364,6 +364,11 @@ EMSCRIPTEN_KEEPALIVE const double* clothlab_positions() {
   g_shown.assign(x.data(), x.data() + x.size());
   return g_shown.data();
 }
+// The positions as the last step left them, 3 doubles per particle (what side by side compares:
+// a step's change shows in the frame that took it, not a frame later as drawn).
+EMSCRIPTEN_KEEPALIVE const double* clothlab_state_positions() {
+  return g_simulation->world().particles.x.data();
+}
 EMSCRIPTEN_KEEPALIVE int clothlab_triangle_count() {
   return static_cast<int>(g_triangles.size() / 3);
 }

@@ -36,6 +36,7 @@
       potential: f('clothlab_potential', 'number', []),
       particles: f('clothlab_particles', 'number', []),
       positions: f('clothlab_positions', 'number', []),
+      statePositions: f('clothlab_state_positions', 'number', []),
       triangleCount: f('clothlab_triangle_count', 'number', []),
       triangles: f('clothlab_triangles', 'number', []),
       springCount: f('clothlab_spring_count', 'number', []),
@@ -80,6 +81,11 @@
   }
   let source = null;  // this page's engine, as sourceOf() gives it
 
+  // The positions as the last step left them (not as drawn, between the last two steps).
+  function statePositions(m, a) {
+    return new Float64Array(m.HEAPF64.buffer, a.statePositions(), 3 * a.particles());
+  }
+
   function positions() {
     return source.positions();
   }
@@ -91,6 +97,7 @@
     showMessage('', '');
     const status = api.load(text, name);
     $('editor').value = text;
+    twin.load(text, name, status);
     if (!check(status)) return false;
     sceneText = text;
     loadedText = text;
@@ -99,7 +106,6 @@
     energy.clear();
     buildSliders();
     readIntegrator();
-    twin.load(text, name);
     rebuildView(false);
     setRunning(true);
     return true;
@@ -313,7 +319,7 @@
   // runs the same scene with the same slider changes, frame times and mouse, and the page marks
   // the first frame where any particle of the student's cloth is farther than the tolerance
   // from the reference's: the frame, its time, the particle and the distance. Frames are
-  // compared after each advance, on the positions drawn.
+  // compared after each advance, on the positions the last step left.
   const twin = {
     engine: null, api: null, source: null, on: false,
     tolerance: 1e-9, frames: 0, worst: 0, first: null,
@@ -326,7 +332,7 @@
         this.api = bind(m);
         this.source = sourceOf(m, this.api);
         this.on = true;
-        load(sceneText, sceneName);
+        load($('editor').value, sceneName);  // the scene as shown, from its start
       };
       return this.engine ? Promise.resolve(begin(this.engine)) : factory().then(begin);
     },
@@ -336,11 +342,19 @@
       rebuildView(true);
       this.show();
     },
-    load(text, name) {
+    // Reads the scene the page has just read with `status`: the student's code may have stopped
+    // while building it (a stub the construction calls), which is then the first difference.
+    load(text, name, status) {
       this.frames = 0;
       this.worst = 0;
       this.first = null;
-      if (this.on && !this.mirror(this.api.load(text, name), 'read the scene')) return;
+      if (!this.on) return;
+      const twinStatus = this.api.load(text, name);
+      if (status !== 0 && twinStatus === 0) {
+        this.first = { frame: 0, time: 0, text: `your code stopped (${kStatus[status]}): ${api.message()}` };
+      } else if (status === 0) {
+        this.mirror(twinStatus, 'read the scene');
+      }
       this.show();
     },
     reload(text, name) {
@@ -366,7 +380,7 @@
                              : `the reference stopped (${kStatus[twinStatus]}): ${this.api.message()}`,
         };
       } else {
-        const a = source.positions(), b = this.source.positions();
+        const a = statePositions(module, api), b = statePositions(this.engine, this.api);
         let worst = a.length === b.length ? 0 : Infinity, at = -1;
         for (let k = 0; k < Math.min(a.length, b.length); ++k) {
           const d = Math.abs(a[k] - b[k]);
