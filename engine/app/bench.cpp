@@ -19,6 +19,7 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <functional>
 #include <map>
 #include <stdexcept>
 #include <string>
@@ -40,7 +41,7 @@ extern char** environ;
 
 namespace clothlab::app {
 
-extern const std::string_view kPlotAccuracyScript;
+extern const std::string_view kPlotScript;
 
 namespace {
 
@@ -150,18 +151,6 @@ std::string sci(double value) {
   return std::isfinite(value) ? fmt::format("{:.2e}", value) : "-";
 }
 
-// Runs `python3 script csv out` and prints what it printed; returns its exit status (127 when
-// python3 cannot start). Debian's own python3 comes first: that is where `apt-get install
-// python3-matplotlib` puts matplotlib, whatever other python3 comes first on the PATH.
-int run_python(const fs::path& script, const fs::path& csv, const fs::path& out) {
-  const ProcessResult run =
-      run_process({fs::exists("/usr/bin/python3") ? "/usr/bin/python3" : "python3", script.string(),
-                   csv.string(), out.string()},
-                  600);
-  fmt::print("{}", run.output);
-  return run.timed_out || run.signal != 0 ? 1 : run.exit_code;
-}
-
 // The cheapest stable run of each target accuracy: what the study is for.
 void print_cheapest(const std::vector<AccuracyRun>& runs) {
   fmt::print("\n  cheapest stable run reaching each error (wall time per simulated second):\n");
@@ -249,10 +238,28 @@ int bench_accuracy(const AccuracyOptions& opt) {
   }
   write_whole_file(csv, table);
   const fs::path script = out_dir / "plot_accuracy.py";
-  write_whole_file(script, kPlotAccuracyScript);
+  write_whole_file(script, kPlotScript);
   fmt::print("\n  wrote {} and {}\n", csv.string(), script.string());
   if (opt.no_plot) return 0;
-  const fs::path plot = opt.plot.empty() ? out_dir / "work-precision.svg" : fs::path(opt.plot);
+  draw_plot(script, csv, opt.plot.empty() ? out_dir / "work-precision.svg" : fs::path(opt.plot));
+  return 0;
+}
+
+// Runs `python3 script csv out` and prints what it printed; returns its exit status (127 when
+// python3 cannot start). Debian's own python3 comes first: that is where `apt-get install
+// python3-matplotlib` puts matplotlib, whatever other python3 comes first on the PATH.
+int run_python(const fs::path& script, const fs::path& csv, const fs::path& out) {
+  const ProcessResult run =
+      run_process({fs::exists("/usr/bin/python3") ? "/usr/bin/python3" : "python3", script.string(),
+                   csv.string(), out.string()},
+                  600);
+  fmt::print("{}", run.output);
+  return run.timed_out || run.signal != 0 ? 1 : run.exit_code;
+}
+
+}  // namespace
+
+void draw_plot(const fs::path& script, const fs::path& csv, const fs::path& plot) {
   const int status = run_python(script, csv, plot);
   if (status != 0) {
     fmt::print(stderr,
@@ -261,10 +268,21 @@ int bench_accuracy(const AccuracyOptions& opt) {
                status == 127 ? "python3 did not start" : "the plot script failed", script.string(),
                csv.string(), plot.string());
   }
-  return 0;
 }
 
-}  // namespace
+void run_bench_command(std::string_view name, const std::function<int()>& body) {
+  int status = 0;
+  try {
+    status = body();
+  } catch (const SceneError& e) {
+    fmt::print(stderr, "error: {}\n", e.what());
+    status = 2;  // a bad scene, as for `clothlab run`
+  } catch (const std::exception& e) {
+    fmt::print(stderr, "error: bench {}: {}\n", name, e.what());
+    status = 1;
+  }
+  if (status != 0) throw CLI::RuntimeError(status);
+}
 
 void add_bench_command(CLI::App& app) {
   CLI::App* bench = app.add_subcommand("bench", "Measure the engine (figures and ratios)");
@@ -315,19 +333,10 @@ void add_bench_command(CLI::App& app) {
       ->check(CLI::PositiveNumber)
       ->capture_default_str();
   accuracy->add_flag("--quick", a.quick, "A shorter ladder of time steps (for tests)");
-  accuracy->callback([] {
-    int status = 0;
-    try {
-      status = bench_accuracy(accuracy_options);
-    } catch (const SceneError& e) {
-      fmt::print(stderr, "error: {}\n", e.what());
-      status = 2;  // a bad scene, as for `clothlab run`
-    } catch (const std::exception& e) {
-      fmt::print(stderr, "error: bench accuracy: {}\n", e.what());
-      status = 1;
-    }
-    if (status != 0) throw CLI::RuntimeError(status);
-  });
+  accuracy->callback(
+      [] { run_bench_command("accuracy", [] { return bench_accuracy(accuracy_options); }); });
+
+  add_bench_methods_command(*bench);
 }
 
 }  // namespace clothlab::app

@@ -7,6 +7,8 @@
 //   clothlab watch [exNN[.k]]         grade again on every save of an exercise file
 //   clothlab bench boundary           measure what the exercise boundary costs
 //   clothlab bench speed              the engine's speed on cloths of 32^2 to 256^2 particles
+//   clothlab bench accuracy [SCENE]   every integrator's error against its cost (lesson 07)
+//   clothlab bench methods [SCENES]   lesson 12's bake-off of the methods on cloth
 //
 // The same code builds `clothlab` (reference solutions) and `clothlab-student` (your
 // exercises); app::kKernels says which.

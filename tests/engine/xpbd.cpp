@@ -59,6 +59,19 @@ void run(World& world, double dt, long steps) {
     world.step(dt);
 }
 
+// Steps `world` `steps` times by dt [s], requiring that no step ends with more energy than it
+// began with (beyond rounding, 1e-12 J); returns the energy at the end [J].
+double step_without_energy_growth(World& world, double dt, int steps) {
+  double e = world.kinetic_energy() + world.potential_energy();
+  for (int s = 0; s < steps; ++s) {
+    world.step(dt);
+    const double next = world.kinetic_energy() + world.potential_energy();
+    REQUIRE(next <= e + 1e-12);
+    e = next;
+  }
+  return e;
+}
+
 // How far below its rest position (y = -links m) the bottom of the chain hangs [m].
 double sag(const World& world, int links) {
   return -static_cast<double>(links) - world.particles.x(1, links);
@@ -206,17 +219,77 @@ TEST_CASE("xpbd: the energy of an undamped spring never grows") {
   World world = test::anchored_spring(1.0, 100.0, 0.0, 0.1, 0.0);
   use_xpbd(world, 4, 1);
   const double e0 = world.kinetic_energy() + world.potential_energy();
-  double e = e0;
-  for (int s = 0; s < 1000; ++s) {
-    world.step(0.01);
-    const double next = world.kinetic_energy() + world.potential_energy();
-    REQUIRE(next <= e + 1e-12);
-    e = next;
-  }
+  const double e = step_without_energy_growth(world, 0.01, 1000);
   const double implicit_euler = e0 * std::pow(1.0 + 0.025 * 0.025, -4000.0);
   MESSAGE("energy " << e0 << " J -> " << e << " J; implicit Euler's factor gives " << implicit_euler
                     << " J");
   CHECK(e == doctest::Approx(implicit_euler).epsilon(0.02));
+}
+
+TEST_CASE("xpbd: a spring's damper decays the motion as the damped oscillator's closed form") {
+  // One particle (m = 1 kg) on a spring (ks = 100 N/m, kd = 2 N s/m) to a pinned anchor, pulled
+  // 0.1 m and released: w = 10 rad/s, zeta = kd / (2 sqrt(ks m)) = 0.1, and
+  //   x(t) = x0 exp(-zeta w t) (cos(wd t) + zeta w / wd sin(wd t)),   wd = w sqrt(1 - zeta^2).
+  // XPBD's damping term (eq. 26, beta = kd) is implicit, like its spring, so the method is first
+  // order: its error falls in proportion to the substep. Over 3 s (e^-3 of the swing left),
+  // implicit Euler's own leak, a relative 1/2 w^2 h per second, bounds the error by about
+  // 0.1 m x 1/2 w^2 h t e^-(zeta w t) at its worst (t = 1 s): 1.8e-4 m at h = 1e-4 s (measured:
+  // 1.84e-4 m; checked with 40 % room), and ten times more at h = 1e-3 s (measured: 1.80e-3 m).
+  // A damper ignored leaves the whole swing (an error near 0.1 m); one counted twice decays as
+  // e^-2 t instead of e^-t and misses by more than 0.02 m.
+  const double x0 = 0.1, w = 10.0, zeta = 0.1, wd = w * std::sqrt(1.0 - zeta * zeta);
+  const auto exact = [&](double t) {
+    return x0 * std::exp(-zeta * w * t) * (std::cos(wd * t) + zeta * w / wd * std::sin(wd * t));
+  };
+  const auto worst_error = [&](int substeps) {
+    World world = test::anchored_spring(1.0, 100.0, 2.0, x0, 0.0);
+    use_xpbd(world, substeps, 1);
+    double worst = 0.0;
+    for (int s = 1; s <= 300; ++s) {
+      world.step(0.01);
+      worst = std::max(worst, std::abs(world.particles.x(0, 1) - 1.0 - exact(0.01 * s)));
+    }
+    return worst;
+  };
+  const double fine = worst_error(100), coarse = worst_error(10);
+  MESSAGE("largest distance from the closed form: " << coarse << " m at h = 1e-3 s, " << fine
+                                                    << " m at h = 1e-4 s");
+  CHECK(fine <= 2.5e-4);
+  CHECK(coarse / fine == doctest::Approx(10.0).epsilon(0.2));  // first order
+}
+
+TEST_CASE(
+    "xpbd: with a damper the energy never grows, at any kd; without one the step is the same") {
+  // The damping term only takes energy out: each step, at 10 ms with 4 substeps, must end with
+  // no more energy than it began with (to 1e-12 J), for a damper at 0.1 times critical and at
+  // 100 times critical (kd = 2000 N s/m). The latter is where the damper as an explicit force
+  // would blow up: it is stable only while kd w dt_s < 2, and here kd w dt_s = 2000 x 2.5e-3 = 5.
+  for (const double kd : {2.0, 2000.0}) {
+    CAPTURE(kd);
+    World world = test::anchored_spring(1.0, 100.0, kd, 0.1, 0.0);
+    use_xpbd(world, 4, 1);
+    const double e0 = world.kinetic_energy() + world.potential_energy();
+    const double e = step_without_energy_growth(world, 0.01, 500);
+    // After 5 s the swing at 0.1 critical keeps exp(-2 zeta w t) = exp(-10) of its energy; the
+    // overdamped spring creeps back as exp(-ks t / kd), keeping exp(-0.5) = 0.61 of it.
+    CHECK(e < (kd == 2.0 ? 1e-4 : 0.7) * e0);
+  }
+  // kd = 0: a substep is exactly implicit Euler on the spring (the test above): from s = 0.1 m,
+  // v = 0, s' = (s + h v) / (1 + (w h)^2), v' = (s' - s) / h, to rounding.
+  World world = test::anchored_spring(1.0, 100.0, 0.0, 0.1, 0.0);
+  use_xpbd(world, 4, 1);
+  double s = 0.1, v = 0.0;
+  const double h = 0.0025;
+  for (int step = 0; step < 100; ++step) {
+    world.step(0.01);
+    for (int k = 0; k < 4; ++k) {
+      const double next = (s + h * v) / (1.0 + 100.0 * h * h);
+      v = (next - s) / h;
+      s = next;
+    }
+  }
+  CHECK(std::abs(world.particles.x(0, 1) - 1.0 - s) <= 1e-12);
+  CHECK(std::abs(world.particles.v(0, 1) - v) <= 1e-9);
 }
 
 TEST_CASE("xpbd: scenes read substeps and iterations and run with pins and colliders") {

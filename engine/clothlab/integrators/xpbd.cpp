@@ -7,6 +7,31 @@
 
 namespace clothlab {
 
+namespace {
+
+// The damper of a spring as XPBD's damping term (Macklin et al. 2016, eq. 26), folded into the
+// undamped projection (the exercise's kernel, eq. 18). With g = grad C . (x - x_old), how far
+// the substep has stretched the constraint so far [m], eq. 26 reads
+//   delta_lambda = (-C - alpha_tilde lambda - gamma g) / ((1 + gamma) (w_i + w_j) + alpha_tilde)
+// and, divided through by (1 + gamma), it is eq. 18 with
+//   C_d = (C + gamma g) / (1 + gamma)      in place of C,
+//   alpha_tilde / (1 + gamma)              in place of alpha_tilde.
+// The kernel computes C = l - l0 itself, so it is handed l0_d = l - C_d. Here
+// gamma = alpha_tilde beta_tilde / dt_s with beta_tilde = dt_s^2 beta and beta = kd: a distance
+// constraint's damping force -beta grad C^T grad C v is the damper -kd ((v_i - v_j) . e) e,
+// so gamma = kd / (ks dt_s). Changes alpha_tilde and l0; leaves them when the ends coincide.
+void damp(const Vec3& dx_i, const Vec3& dx_j, const Vec3& d, double gamma, double& alpha_tilde,
+          double& l0) {
+  const double l = d.norm();  // [m]
+  if (l == 0.0) return;       // no direction: the kernel moves nothing either
+  const double C = l - l0;
+  const double g = d.dot(dx_i - dx_j) / l;  // grad C . (x - x_old), grad_i C = d / l = -grad_j C
+  l0 = l - (C + gamma * g) / (1.0 + gamma);
+  alpha_tilde /= 1.0 + gamma;
+}
+
+}  // namespace
+
 void Xpbd::advance(World& world, double dt) {
   Particles& p = world.particles;
   const Index n = p.size();
@@ -33,12 +58,12 @@ void Xpbd::advance(World& world, double dt) {
       if (!dynamic_cast<const SpringDampers*>(effect.get()))
         effect->add_forces(p, p.x, p.v, f_ext_);
     }
-    // The springs' dampers, explicitly: the spring-damper force with ks = 0 is the damper
-    // -kd ((v_i - v_j) . e) e alone. Stable while kd (w_i + w_j) dt_s < 2, which small substeps
-    // give for any cloth damper (lesson 12).
+    // A damper without a spring (ks = 0) is no constraint: it acts as an explicit force, the
+    // spring-damper force with ks = 0, -kd ((v_i - v_j) . e) e. Stable while
+    // kd (w_i + w_j) dt_s < 2. Every other damper is in the projection below.
     for (const SpringSet* set : families) {
       for (size_t k = 0; k < set->size(); ++k) {
-        if (set->kd(k) == 0.0) continue;
+        if (set->kd(k) == 0.0 || set->ks(k) > 0.0) continue;
         const Index i = set->i(k), j = set->j(k);
         const Vec3 f = spring_damper_force(p.x.col(i), p.x.col(j), p.v.col(i), p.v.col(j), 0.0,
                                            set->kd(k), set->l0(k));
@@ -61,10 +86,15 @@ void Xpbd::advance(World& world, double dt) {
         for (size_t k = 0; k < set->size(); ++k, ++c) {
           if (set->ks(k) <= 0.0) continue;  // no stiffness: no constraint (alpha = infinity)
           const Index i = set->i(k), j = set->j(k);
-          const double alpha_tilde = 1.0 / (set->ks(k) * h * h);  // alpha / dt_s^2, alpha = 1/ks
           Vec3 x_i = p.x.col(i), x_j = p.x.col(j);
-          const double delta_lambda = xpbd_distance_projection(x_i, x_j, p.inv_m[i], p.inv_m[j],
-                                                               set->l0(k), alpha_tilde, lambda_[c]);
+          double alpha_tilde = 1.0 / (set->ks(k) * h * h);  // alpha / dt_s^2, alpha = 1/ks
+          double l0 = set->l0(k);
+          if (set->kd(k) > 0.0) {
+            damp(x_i - x_old_.col(i), x_j - x_old_.col(j), x_i - x_j, set->kd(k) / (set->ks(k) * h),
+                 alpha_tilde, l0);
+          }
+          const double delta_lambda = xpbd_distance_projection(x_i, x_j, p.inv_m[i], p.inv_m[j], l0,
+                                                               alpha_tilde, lambda_[c]);
           p.x.col(i) = x_i;
           p.x.col(j) = x_j;
           if (keep_lambda) lambda_[c] += delta_lambda;

@@ -16,9 +16,16 @@
 // (and reset to 0 at the start of each step); -lambda / dt^2 is the spring's tension [N]. With
 // alpha = 0 the constraint is rigid: this is the projection of Jakobsen and of plain PBD.
 //
+// A spring's damper kd [N s/m] is the paper's damping term (its eq. 26), beta = kd:
+//   gamma        = alpha_tilde beta_tilde / dt = kd / (ks dt),    beta_tilde = dt^2 beta
+//   delta_lambda = (-C - alpha_tilde lambda - gamma grad C . (x - x_old))
+//                  / ((1 + gamma) (w_i + w_j) + alpha_tilde)
+// which resists the constraint's rate of change over the step, implicitly: stable for any kd.
+// (xpbd.cpp folds it into the undamped projection above; kd = 0 leaves that unchanged.)
+//
 // One step of dt with `substeps` substeps of dt_s = dt / substeps, each (Small Steps):
-//   f_ext  = every force effect but the springs, at the substep's start, plus the springs'
-//            dampers, -kd ((v_i - v_j) . e) e (treated as external forces, explicitly)
+//   f_ext  = every force effect but the springs, at the substep's start (and the dampers of
+//            springs with ks = 0, which are no constraints, as explicit forces)
 //   x_old  = x
 //   x      = x + dt_s v + dt_s^2 w f_ext                          the prediction x*
 //   repeat `iterations` times: project every constraint (above), in order

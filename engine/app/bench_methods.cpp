@@ -1,0 +1,454 @@
+// bench_methods.cpp: `clothlab bench methods`, lesson 12's bake-off of the methods on cloth.
+//
+// Each scene runs under every method over a ladder of settings: symplectic Euler and RK4 from
+// the largest step the stability advisor allows (lesson 08) down, implicit Euler from one step a
+// frame down, XPBD at one step a frame with more and more substeps or iterations, and the
+// local/global solver when the engine has it. Every run is compared, frame by frame, with a
+// reference of the same spring model: RK4 at a step far below its stability limit. The
+// reference is run twice, at dt_ref and dt_ref / 2, and the difference between the two is
+// printed beside the methods' errors: the reference has converged where that difference is far
+// below them.
+//
+// For each run: the error (the particles' root-mean-square distance from the reference over
+// all frames, relative to the cloth's size), the worst strain |l - l0| / l0 of a structural or
+// shear spring at any frame, the energy lost against the reference by the end (relative to the
+// largest kinetic energy the reference reached: 1 is all the motion the cloth ever had), and the
+// wall time per simulated second (fastest repeat). A
+// CSV, and a plot per scene drawn by a small matplotlib script written next to it.
+//
+// `--speed`: on a 128 x 128 cloth, what a symplectic Euler step costs per spring against one
+// XPBD projection per spring, measured in the same run.
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <filesystem>
+#include <limits>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include <fmt/format.h>
+#include <toml++/toml.h>
+
+#include "analysis/stability.hpp"
+#include "app/bench.hpp"
+#include "clothlab/core/guard.hpp"
+#include "clothlab/forces/spring_damper.hpp"
+#include "clothlab/integrators/integrator.hpp"
+#include "io/files.hpp"
+#include "scene/scene.hpp"
+
+namespace clothlab::app {
+
+extern const std::string_view kPlotScript;
+
+namespace {
+
+namespace fs = std::filesystem;
+using Clock = std::chrono::steady_clock;
+
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+constexpr double kFrame = 1.0 / 60.0;  // [s]: errors are sampled once a frame of a 60 Hz game
+
+struct MethodsOptions {
+  std::vector<std::string> scenes;  // empty: lesson 12's three bake-off scenes
+  std::string out = "clothlab-out/methods";
+  std::string plot;  // empty: OUT/methods.svg
+  bool no_plot = false;
+  bool quick = false;
+  double min_seconds = 0.05;  // wall time each run is repeated for
+  bool speed = false;
+  int grid = 128;  // the speed measurement's cloth: grid x grid particles
+};
+
+// One setting of one method: its step is one frame over per_frame; substeps and iterations
+// are written to [integrator] when they are not 0.
+struct Config {
+  std::string method;
+  int per_frame = 1;
+  int substeps = 0;
+  int iterations = 0;
+  double dt() const { return kFrame / per_frame; }
+};
+
+// A method's ladder, as data. Steps per frame are `base * factor`, where base is 1 or, for
+// `from_limit`, the fewest steps a frame that the stability advisor calls stable; each rung runs
+// with every (substeps, iterations) pair of `inner` ({0, 0}: the method has neither).
+struct Ladder {
+  std::string_view method;
+  bool from_limit;
+  std::vector<double> factors;
+  std::vector<std::pair<int, int>> inner = {{0, 0}};
+};
+
+std::vector<Ladder> ladders(bool quick) {
+  if (quick) {
+    return {{"symplectic-euler", true, {1, 2, 4}},
+            {"rk4", true, {1, 2}},
+            {"implicit-euler", false, {1, 4, 16}},
+            {"xpbd", false, {1}, {{1, 1}, {8, 1}, {64, 1}, {1, 8}}},
+            {"xpbd", false, {8}, {{8, 1}}},
+            {"local-global", false, {1, 4}, {{0, 10}}}};
+  }
+  // Symplectic Euler's first rung takes twice the advised step, to show where it fails.
+  return {
+      {"symplectic-euler", true, {0.5, 1, 2, 4, 8}},
+      {"rk4", true, {1, 2, 4}},
+      {"implicit-euler", false, {1, 2, 4, 8, 16, 32}},
+      {"xpbd", false, {1}, {{1, 1}, {4, 1}, {16, 1}, {64, 1}, {256, 1}, {1, 4}, {1, 16}, {1, 64}}},
+      // 64 substeps a frame again, in 8 steps: the post-step effects (colliders) act after
+      // every step, not every substep, so this is how a collider sees XPBD's small steps.
+      {"xpbd", false, {8}, {{8, 1}}},
+      {"local-global", false, {1, 2, 4, 8, 16}, {{0, 10}}}};
+}
+
+bool engine_has(std::string_view method) {
+  const auto names = method_names();
+  return std::find(names.begin(), names.end(), method) != names.end();
+}
+
+// A scene file and what every run of it shares.
+struct BakeoffScene {
+  std::string path;
+  toml::table table;  // the file, whose [integrator] each run replaces
+  int frames = 0;     // the run's length in frames
+  double size = 1.0;  // the diagonal of the particles' bounding box at the start [m]
+};
+
+BakeoffScene read_bakeoff_scene(const std::string& path, int max_frames) {
+  BakeoffScene scene;
+  scene.path = path;
+  const Scene loaded = load_scene_file(path);  // the scene's own errors, with lines and columns
+  scene.table = toml::parse_file(path);
+  scene.frames = std::clamp(static_cast<int>(std::lround(loaded.duration / kFrame)), 1, max_frames);
+  const Matrix3X& x0 = loaded.world.particles.x;
+  const double diagonal = (x0.rowwise().maxCoeff() - x0.rowwise().minCoeff()).norm();
+  scene.size = diagonal > 0.0 ? diagonal : 1.0;
+  return scene;
+}
+
+// The scene's world, stepped by `config`: its file with [integrator] written anew. (Through the
+// scene reader, so a method's own keys, such as `iterations`, mean what they mean in a scene.)
+World make_world(const BakeoffScene& scene, const Config& config) {
+  toml::table table = scene.table;
+  toml::table integrator{
+      {"method", config.method}, {"dt", config.dt()}, {"duration", scene.frames * kFrame}};
+  if (config.substeps > 0) integrator.insert("substeps", config.substeps);
+  if (config.iterations > 0) integrator.insert("iterations", config.iterations);
+  table.insert_or_assign("integrator", std::move(integrator));
+  std::ostringstream text;
+  text << table;
+  return std::move(parse_scene(text.str(), scene.path).world);
+}
+
+// The fewest steps a frame at which the advisor calls `method` stable on the scene at rest.
+int advised_per_frame(const BakeoffScene& scene, std::string_view method) {
+  const World world = make_world(scene, Config{std::string(method)});
+  const double limit = advise_time_step(world, kFrame, scene.frames).dt_limit;
+  if (!(limit > 0.0) || !std::isfinite(limit)) return 1;
+  return std::max(1, static_cast<int>(std::ceil(kFrame / limit)));
+}
+
+// The largest |l - l0| / l0 of the structural and shear springs.
+double worst_strain(const World& world) {
+  double worst = 0.0;
+  for (const auto& effect : world.force_effects) {
+    if (effect->name() != "springs") continue;
+    const SpringSet& s = dynamic_cast<const SpringDampers&>(*effect).springs();
+    for (size_t k = 0; k < s.size(); ++k) {
+      const double l = (world.particles.x.col(s.i(k)) - world.particles.x.col(s.j(k))).norm();
+      if (s.l0(k) > 0.0) worst = std::max(worst, std::abs(l - s.l0(k)) / s.l0(k));
+    }
+  }
+  return worst;
+}
+
+// What a run leaves at each frame (frame 0 is the start).
+struct Trajectory {
+  std::vector<Matrix3X> x;
+  std::vector<double> energy;   // kinetic + potential [J]
+  std::vector<double> kinetic;  // [J]
+  double worst_strain = 0.0;
+  double seconds = 0.0;  // wall time of the steps alone
+  std::string stopped;   // the guard's message when it stopped the run
+};
+
+Trajectory simulate(const BakeoffScene& scene, const Config& config, bool record) {
+  Trajectory run;
+  World world = make_world(scene, config);
+  const double dt = config.dt();
+  const auto sample = [&] {
+    if (!record) return;
+    run.x.push_back(world.particles.x);
+    run.kinetic.push_back(world.kinetic_energy());
+    run.energy.push_back(run.kinetic.back() + world.potential_energy());
+    run.worst_strain = std::max(run.worst_strain, worst_strain(world));
+  };
+  sample();
+  try {
+    for (int f = 0; f < scene.frames; ++f) {
+      const Clock::time_point start = Clock::now();
+      for (int s = 0; s < config.per_frame; ++s)
+        world.step(dt);
+      run.seconds += std::chrono::duration<double>(Clock::now() - start).count();
+      sample();
+    }
+  } catch (const SimulationError& e) {
+    run.stopped = e.what();
+  }
+  return run;
+}
+
+// The particles' RMS distance between two runs over every frame after the start, relative to
+// the scene's size; NaN when a run stopped early.
+double difference(const Trajectory& run, const Trajectory& reference, double size) {
+  if (run.x.size() != reference.x.size() || run.x.size() < 2) return kNaN;
+  double sum = 0.0;
+  Index count = 0;
+  for (size_t f = 1; f < run.x.size(); ++f) {
+    sum += (run.x[f] - reference.x[f]).colwise().squaredNorm().sum();
+    count += run.x[f].cols();
+  }
+  return std::sqrt(sum / static_cast<double>(count)) / size;
+}
+
+struct MethodRun {
+  std::string scene;
+  Config config;
+  double error = kNaN, worst_strain = kNaN, energy_lost = kNaN;
+  double wall_per_sim = kNaN;  // [s per simulated s], fastest repeat
+  long steps = 0;              // steps over the run
+  bool stable = false;
+  bool reference = false;  // the reference's row: its error is its own difference at dt / 2
+};
+
+// "1.23e-04" or "-" for a number that is not one.
+std::string sci(double value) {
+  return std::isfinite(value) ? fmt::format("{:.2e}", value) : "-";
+}
+
+std::string setting(const Config& c) {
+  std::string text;
+  if (c.substeps > 0) text += fmt::format("{} substeps", c.substeps);
+  if (c.iterations > 0) text += fmt::format("{}{} it", text.empty() ? "" : " x ", c.iterations);
+  return text.empty() ? "-" : text;
+}
+
+void print_row(const MethodRun& r) {
+  fmt::print("  {:<17} {:>9.3g} {:>19} {:>9} {:>9} {:>9} {:>12}  {}\n",
+             r.reference ? "reference (rk4)" : r.config.method, r.config.dt(), setting(r.config),
+             sci(r.error), sci(r.worst_strain), sci(r.energy_lost), sci(r.wall_per_sim),
+             r.reference ? "its own difference at dt/2" : (r.stable ? "yes" : "no"));
+}
+
+// Every run of one scene, the reference first.
+std::vector<MethodRun> bake_off(const std::string& path, const MethodsOptions& opt) {
+  // --quick: half a second at most.
+  const BakeoffScene scene = read_bakeoff_scene(path, opt.quick ? 30 : 1'000'000);
+  const double sim_seconds = scene.frames * kFrame;
+  fmt::print("\nscene {}: {} frames of 1/60 s ({:.3g} s), size {:.3g} m\n", path, scene.frames,
+             sim_seconds, scene.size);
+
+  // The reference: RK4 at a step 128 (quick: 16) times below its advised limit, 16 (quick: 4)
+  // times below the finest rung of the ladders, and at half that step. That far, because a
+  // scene's wind and colliders make every method first order (see the lesson).
+  const int per_frame_ref = (opt.quick ? 16 : 128) * advised_per_frame(scene, "rk4");
+  const Config reference_config{"rk4", per_frame_ref};
+  const Trajectory reference = simulate(scene, reference_config, true);
+  const Trajectory finer = simulate(scene, Config{"rk4", 2 * per_frame_ref}, true);
+  if (!reference.stopped.empty()) {
+    throw std::runtime_error(fmt::format("the RK4 reference of {} at dt = {:.3g} s stopped: {}",
+                                         path, reference_config.dt(), reference.stopped));
+  }
+  // The scale of the energy lost: the most kinetic energy the reference had at a frame [J].
+  double motion = *std::max_element(reference.kinetic.begin(), reference.kinetic.end());
+  if (!(motion > 0.0)) motion = 1.0;
+
+  fmt::print("  energy lost is relative to {:.3g} J, the reference's largest kinetic energy\n",
+             motion);
+  std::vector<MethodRun> runs;
+  MethodRun ref_row{path, reference_config};
+  ref_row.reference = true;
+  ref_row.steps = static_cast<long>(scene.frames) * per_frame_ref;
+  ref_row.error = difference(finer, reference, scene.size);
+  ref_row.worst_strain = reference.worst_strain;
+  ref_row.energy_lost = 0.0;
+  ref_row.wall_per_sim = reference.seconds / sim_seconds;
+  ref_row.stable = true;
+  fmt::print("  {:<17} {:>9} {:>19} {:>9} {:>9} {:>9} {:>12}  {}\n", "method", "dt [s]", "setting",
+             "error", "strain", "E lost", "wall s/sim s", "stable");
+  print_row(ref_row);
+  runs.push_back(ref_row);
+
+  for (const Ladder& ladder : ladders(opt.quick)) {
+    if (!engine_has(ladder.method)) continue;  // the local/global solver, before lesson 13
+    const int base = ladder.from_limit ? advised_per_frame(scene, ladder.method) : 1;
+    for (double factor : ladder.factors) {
+      const int per_frame = static_cast<int>(std::lround(base * factor));
+      if (per_frame < 1) continue;
+      for (const auto& [substeps, iterations] : ladder.inner) {
+        MethodRun row{path, Config{std::string(ladder.method), per_frame, substeps, iterations}};
+        row.steps = static_cast<long>(scene.frames) * per_frame;
+        const Trajectory run = simulate(scene, row.config, true);
+        row.error = difference(run, reference, scene.size);
+        row.stable = run.stopped.empty() && std::isfinite(row.error) && row.error < 1.0;
+        if (run.stopped.empty()) {
+          row.worst_strain = run.worst_strain;
+          row.energy_lost = (reference.energy.back() - run.energy.back()) / motion;
+          // The fastest of the repeats that fit in min_seconds (at most 100).
+          double best = run.seconds, total = run.seconds;
+          for (int r = 0; r < 100 && total < opt.min_seconds; ++r) {
+            const double seconds = simulate(scene, row.config, false).seconds;
+            best = std::min(best, seconds);
+            total += seconds;
+          }
+          row.wall_per_sim = best / sim_seconds;
+        }
+        print_row(row);
+        runs.push_back(row);
+      }
+    }
+  }
+  return runs;
+}
+
+// --- --speed: ns per spring ---------------------------------------------------------------
+
+// A grid x grid cloth of structural and shear springs, hanging from its top corners.
+std::string speed_scene(int grid, std::string_view method, int substeps, int iterations) {
+  std::string text = fmt::format(
+      "[cloth]\nrows = {0}\ncols = {0}\nspacing = 0.01\nplane = \"vertical\"\ndensity = 0.15\n"
+      "pins = \"top-corners\"\n[springs]\nks = 500.0\nkd = 0.001\nshear_ks = 100.0\n"
+      "[gravity]\ng = [0.0, -9.8, 0.0]\n[integrator]\nmethod = \"{1}\"\ndt = 1e-4\n"
+      "duration = 1.0\n",
+      grid, method);
+  if (substeps > 0) text += fmt::format("substeps = {}\niterations = {}\n", substeps, iterations);
+  return text;
+}
+
+// The fastest of `repeats` wall times [s] of `steps` steps of the scene.
+double time_steps(const std::string& text, int steps, int repeats) {
+  double best = std::numeric_limits<double>::infinity();
+  for (int r = 0; r < repeats; ++r) {
+    World world = std::move(parse_scene(text, "<speed>").world);
+    const Clock::time_point start = Clock::now();
+    for (int s = 0; s < steps; ++s)
+      world.step(1e-4);
+    best = std::min(best, std::chrono::duration<double>(Clock::now() - start).count());
+  }
+  return best;
+}
+
+void speed(const MethodsOptions& opt, const fs::path& out_dir) {
+  const int grid = opt.grid, steps = opt.quick ? 5 : 40, repeats = opt.quick ? 2 : 5;
+  const Scene scene = parse_scene(speed_scene(grid, "symplectic-euler", 0, 0), "<speed>");
+  size_t springs = 0;
+  for (const auto& effect : scene.world.force_effects) {
+    if (const auto* s = dynamic_cast<const SpringDampers*>(effect.get()))
+      springs += s->springs().size();
+  }
+  const double per = 1e9 / (static_cast<double>(springs) * steps);  // s per run -> ns per spring
+  constexpr int kMore = 8;  // the extra iterations whose cost is the cost of an iteration
+  const double euler =
+      per * time_steps(speed_scene(grid, "symplectic-euler", 0, 0), steps, repeats);
+  const double one = per * time_steps(speed_scene(grid, "xpbd", 1, 1), steps, repeats);
+  const double many = per * time_steps(speed_scene(grid, "xpbd", 1, 1 + kMore), steps, repeats);
+  const double iteration = (many - one) / kMore;
+  fmt::print("\nspeed: a {0} x {0} cloth, {1} springs, {2} steps, fastest of {3} runs\n", grid,
+             springs, steps, repeats);
+  fmt::print("  symplectic Euler, one step:                   {:8.2f} ns per spring\n", euler);
+  fmt::print("  XPBD, one substep of one iteration:           {:8.2f} ns per spring\n", one);
+  fmt::print("  XPBD, each further iteration (from {:2} vs 1):  {:8.2f} ns per spring\n", 1 + kMore,
+             iteration);
+  fmt::print("  an XPBD iteration costs {:.2f} symplectic Euler steps\n", iteration / euler);
+  std::string table = "grid,springs,measure,ns_per_spring\n";
+  fmt::format_to(std::back_inserter(table), "{0},{1},symplectic-euler-step,{2:.6g}\n", grid,
+                 springs, euler);
+  fmt::format_to(std::back_inserter(table), "{0},{1},xpbd-substep-1-iteration,{2:.6g}\n", grid,
+                 springs, one);
+  fmt::format_to(std::back_inserter(table), "{0},{1},xpbd-iteration,{2:.6g}\n", grid, springs,
+                 iteration);
+  write_whole_file(out_dir / "speed.csv", table);
+  fmt::print("  wrote {}\n", (out_dir / "speed.csv").string());
+}
+
+int bench_methods(const MethodsOptions& opt) {
+  std::vector<std::string> scenes = opt.scenes;
+  if (scenes.empty()) {
+    const fs::path lesson = fs::path(CLOTHLAB_SOURCE_DIR) / "lessons" / "12-xpbd";
+    for (const char* name :
+         {"bakeoff-hanging-sheet.toml", "bakeoff-gusty-flag.toml", "bakeoff-drape.toml"})
+      scenes.push_back((lesson / name).string());
+  }
+  fmt::print(
+      "bench methods: {} scene(s); error = the particles' RMS distance from the reference "
+      "over every 1/60 s frame, relative to the cloth's size; strain = the worst |l - l0| "
+      "/ l0; E lost = energy lost against the reference by the end, relative to the "
+      "reference's largest kinetic energy; wall time per simulated second, fastest "
+      "repeat\n",
+      scenes.size());
+  if (!engine_has("local-global"))
+    fmt::print("  (this engine has no local/global solver: its rows are left out)\n");
+
+  std::vector<MethodRun> runs;
+  for (const std::string& path : scenes) {
+    std::vector<MethodRun> more = bake_off(path, opt);
+    runs.insert(runs.end(), more.begin(), more.end());
+  }
+
+  const fs::path out_dir = opt.out;
+  fs::create_directories(out_dir);
+  const fs::path csv = out_dir / "methods.csv";
+  std::string table =
+      "scene,method,dt,substeps,iterations,steps,error,worst_strain,energy_lost,"
+      "wall_s_per_sim_s,stable\n";
+  for (const MethodRun& r : runs) {
+    fmt::format_to(std::back_inserter(table),
+                   "{},{},{:.17g},{},{},{},{:.17g},{:.17g},{:.17g},"
+                   "{:.17g},{}\n",
+                   fs::path(r.scene).stem().string(), r.reference ? "reference" : r.config.method,
+                   r.config.dt(), r.config.substeps, r.config.iterations, r.steps, r.error,
+                   r.worst_strain, r.energy_lost, r.wall_per_sim, r.stable ? "true" : "false");
+  }
+  write_whole_file(csv, table);
+  const fs::path script = out_dir / "plot_methods.py";
+  write_whole_file(script, kPlotScript);
+  fmt::print("\n  wrote {} and {}\n", csv.string(), script.string());
+  if (opt.speed) speed(opt, out_dir);
+  if (opt.no_plot) return 0;
+  draw_plot(script, csv, opt.plot.empty() ? out_dir / "methods.svg" : fs::path(opt.plot));
+  return 0;
+}
+
+}  // namespace
+
+void add_bench_methods_command(CLI::App& bench) {
+  static MethodsOptions options;
+  CLI::App* methods = bench.add_subcommand(
+      "methods",
+      "Lesson 12's bake-off: each method over a ladder of steps on cloth scenes, against a "
+      "converged RK4 reference (table, CSV and a plot per scene)");
+  methods
+      ->add_option("scenes", options.scenes,
+                   "Scenes to run (default: lesson 12's hanging sheet, gusty flag and drape)")
+      ->check(CLI::ExistingFile);
+  methods->add_option("--out", options.out, "Directory for methods.csv, the plot and its script")
+      ->capture_default_str();
+  methods->add_option("--plot", options.plot,
+                      "Plot file (.svg, .png or .pdf; default OUT/methods.svg)");
+  methods->add_flag("--no-plot", options.no_plot, "Write the CSV and the script, draw nothing");
+  methods->add_flag("--quick", options.quick, "Shorter ladders and a cheaper reference (tests)");
+  methods
+      ->add_option("--min-seconds", options.min_seconds,
+                   "Wall time [s] each run is repeated for; the fastest repeat is kept")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
+  methods->add_flag("--speed", options.speed,
+                    "Also time a symplectic Euler step and an XPBD iteration per spring");
+  methods->add_option("--grid", options.grid, "The speed measurement's cloth: N x N particles")
+      ->check(CLI::Range(4, 1024))
+      ->capture_default_str();
+  methods->callback([] { run_bench_command("methods", [] { return bench_methods(options); }); });
+}
+
+}  // namespace clothlab::app

@@ -1,0 +1,89 @@
+# `clothlab bench methods --quick`: lesson 12's bake-off on its three scenes writes one CSV row per
+# scene and setting in the documented columns; in each scene the reference's difference from
+# itself at half its step is below every stable method's error (the reference has converged), and
+# symplectic Euler's error falls as its step falls; the plot script is written, and the plot drawn
+# when matplotlib is there. Its timings are never checked. Then `--speed` on a small grid writes
+# its CSV.
+cmake_policy(VERSION 3.22)  # quoted strings are strings, never variables' names (CMP0054)
+include(${CMAKE_CURRENT_LIST_DIR}/cli_bench_checks.cmake)
+file(REMOVE_RECURSE ${WORK})
+file(MAKE_DIRECTORY ${WORK})
+run_bench("bench methods" bench methods --quick --min-seconds 0.001 --out out)
+check_header(${WORK}/out/methods.csv "scene,method,dt,substeps,iterations,steps,error,\
+worst_strain,energy_lost,wall_s_per_sim_s,stable")
+file(STRINGS ${WORK}/out/methods.csv lines)
+list(POP_FRONT lines header)
+
+# Per scene, in --quick: the reference, symplectic Euler x 3 steps, RK4 x 2, implicit Euler x 3,
+# XPBD x 5 settings, and the local/global solver x 2 when the engine has it.
+set(rows_per_scene 14)
+if(out MATCHES "local-global")
+  set(rows_per_scene 16)
+endif()
+foreach(scene bakeoff-hanging-sheet bakeoff-gusty-flag bakeoff-drape)
+  set(rows 0)
+  set(self_difference "")
+  set(errors "")  # the stable methods' errors
+  set(euler "")   # symplectic Euler's errors, coarsest step first
+  foreach(line IN LISTS lines)
+    string(REPLACE "," ";" f "${line}")
+    list(GET f 0 name)
+    if(NOT name STREQUAL scene)
+      continue()
+    endif()
+    math(EXPR rows "${rows} + 1")
+    list(GET f 1 method)
+    list(GET f 6 error)
+    list(GET f 10 stable)
+    if(method STREQUAL "reference")
+      set(self_difference ${error})
+    elseif(stable STREQUAL "true")
+      list(APPEND errors ${error})
+      if(method STREQUAL "symplectic-euler")
+        list(APPEND euler ${error})
+      endif()
+    endif()
+  endforeach()
+  if(NOT rows EQUAL rows_per_scene)
+    message(FATAL_ERROR "${scene}: ${rows} rows in methods.csv; expected ${rows_per_scene}\n${out}")
+  endif()
+  if(self_difference STREQUAL "" OR errors STREQUAL "")
+    message(FATAL_ERROR "${scene}: no reference row or no stable run\n${out}")
+  endif()
+  foreach(error IN LISTS errors)
+    if(NOT self_difference LESS error)
+      message(FATAL_ERROR "${scene}: the reference differs from itself by ${self_difference}, not less "
+                          "than a method's error ${error}: it has not converged\n${out}")
+    endif()
+  endforeach()
+  list(LENGTH euler count)
+  if(count LESS 2)
+    message(FATAL_ERROR "${scene}: fewer than two stable symplectic Euler runs\n${out}")
+  endif()
+  set(previous "")
+  foreach(error IN LISTS euler)
+    if(NOT previous STREQUAL "" AND NOT error LESS previous)
+      message(FATAL_ERROR "${scene}: symplectic Euler's error ${error} did not fall below "
+                          "${previous} as its step fell\n${out}")
+    endif()
+    set(previous ${error})
+  endforeach()
+endforeach()
+
+check_plot(${WORK}/out/plot_methods.py ${WORK}/out/methods.svg "${err}")
+
+# --speed on a small grid, and a scene passed by name (here one of the three again).
+run_bench("bench methods --speed" bench methods --quick --no-plot --min-seconds 0.001 --speed
+          --grid 16 --out speed ${SCENE})
+file(STRINGS ${WORK}/speed/speed.csv speed)
+list(LENGTH speed count)
+list(GET speed 0 header)
+if(NOT count EQUAL 4 OR NOT header STREQUAL "grid,springs,measure,ns_per_spring")
+  message(FATAL_ERROR "speed.csv is not a header and three rows:\n${speed}")
+endif()
+file(STRINGS ${WORK}/speed/methods.csv lines)
+list(LENGTH lines count)
+math(EXPR expected "${rows_per_scene} + 1")
+if(NOT count EQUAL expected)
+  message(FATAL_ERROR "one scene gave ${count} lines in methods.csv; expected ${expected}\n${out}")
+endif()
