@@ -4,7 +4,7 @@
 // are the same except inside the regions between "BEGIN exNN.k" and "END exNN.k": write your
 // answer there and leave the rest as it is. Grade your work with `./build/clothlab grade`, and
 // watch a cloth stepped by your local step with
-//   ./build/clothlab-student run lessons/13-local-global/stiff-curtain.toml
+//   ./build/clothlab-student run lessons/13-local-global/canvas-curtain.toml
 // Every symbol is explained in lessons/13-local-global/README.md.
 // Nothing needs rebuilding by hand: the grader, and each student program before it runs,
 // compiles what you saved first.
