@@ -77,7 +77,7 @@ void LocalGlobal::factor(const World& world, double dt) {
   }
   const auto unknowns = static_cast<Index>(particle_.size());
   Eigen::SparseMatrix<double> a(unknowns, unknowns);
-  a.setFromTriplets(triplets.begin(), triplets.end());  // sums the duplicates
+  a.setFromTriplets(triplets.begin(), triplets.end());  // adds up repeated entries
   llt_.compute(a);
   // Every mass is positive and every c >= 0, so A is symmetric positive definite: a failure
   // here is a bug, not a scene to reject.
