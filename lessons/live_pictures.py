@@ -24,6 +24,7 @@ SHOTS = {
     "10-collision-detection": ("towel-on-a-line.toml", 1.5),
     "11-game-loop": ("banner.toml", 2.0),
     "12-xpbd": ("stiff-curtain.toml", 1.0),
+    "13-local-global": ("canvas-curtain.toml", 1.0),
 }
 
 

@@ -27,6 +27,7 @@ PICTURES = {
     "10-collision-detection": ("towel-on-a-line.toml", 50),
     "11-game-loop": ("banner.toml", 240),
     "12-xpbd": ("stiff-curtain.toml", 120),
+    "13-local-global": ("canvas-curtain.toml", 120),
 }
 
 

@@ -281,8 +281,9 @@ TimeStepAdvice advise_time_step(const World& world, double dt, long steps) {
   if (!world.integrator || b.omega_max == 0.0) return advice;  // no springs: nothing to limit
   const std::string method(world.integrator->name());
   // XPBD (lesson 12) moves by constraints, not spring forces: no step limit of its springs to
-  // give. (Its explicit external forces and dampers are held by its small substeps.)
-  if (method == "xpbd") return advice;
+  // give. (Its explicit external forces and dampers are held by its small substeps.) The
+  // local/global solver (lesson 13) steps its springs and dampers implicitly: none either.
+  if (method == "xpbd" || method == "local-global") return advice;
   // The worst row. Until exercise ex08.1 is done, explicit Euler's limit comes from the
   // eigenvalues, as every other method's does.
   const auto worst_row = [&](const auto& limit) {

@@ -21,6 +21,7 @@
 #include "clothlab/forces/gravitation.hpp"
 #include "clothlab/forces/gravity.hpp"
 #include "clothlab/integrators/implicit_euler.hpp"
+#include "clothlab/integrators/local_global.hpp"
 #include "clothlab/integrators/xpbd.hpp"
 
 namespace clothlab {
@@ -786,17 +787,27 @@ void read_integrator(SceneTable& t, Scene& scene) {
   const std::vector<std::string_view> names(method_names().begin(), method_names().end());
   const std::string method = t.choice("method", names, "symplectic-euler");
   scene.world.integrator = make_integrator(method);
-  // The substeps and projections of the position-based method; the force-based ones have none.
-  for (const char* key : {"substeps", "iterations"}) {
-    if (method != "xpbd" && t.has(key)) {
-      t.fail(key, fmt::format("{} sets the position-based method = \"xpbd\" (lesson 12), but "
-                              "method is \"{}\"; expected no {} here",
-                              key, method, key));
-    }
+  // The substeps and projections of the position-based method, the iterations of the
+  // local/global one; the force-based ones have none.
+  if (method != "xpbd" && t.has("substeps")) {
+    t.fail("substeps", fmt::format("substeps sets the position-based method = \"xpbd\" (lesson "
+                                   "12), but method is \"{}\"; expected no substeps here",
+                                   method));
+  }
+  if (method != "xpbd" && method != "local-global" && t.has("iterations")) {
+    t.fail("iterations",
+           fmt::format("iterations sets the iterations of method = \"xpbd\" (lesson 12) or "
+                       "\"local-global\" (lesson 13), but method is \"{}\"; expected no "
+                       "iterations here",
+                       method));
   }
   if (auto* xpbd = dynamic_cast<Xpbd*>(scene.world.integrator.get())) {
     xpbd->substeps = static_cast<int>(t.integer("substeps", 1, 100'000, xpbd->substeps));
     xpbd->iterations = static_cast<int>(t.integer("iterations", 1, 10'000, xpbd->iterations));
+  }
+  if (auto* local_global = dynamic_cast<LocalGlobal*>(scene.world.integrator.get())) {
+    local_global->iterations =
+        static_cast<int>(t.integer("iterations", 1, 10'000, local_global->iterations));
   }
   // The linear solver of the implicit method; another method has none to tune.
   for (const char* key : {"tolerance", "max_iterations"}) {

@@ -1,6 +1,7 @@
 // lesson.hpp: what every lesson program shares, so that each main.cpp holds only its lesson.
 #pragma once
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <exception>
@@ -30,6 +31,17 @@ inline SpringSet& springs_of(World& world) {
   SpringDampers* springs = find_spring_effect(world, "springs");
   if (!springs) throw std::runtime_error("the scene has no [springs]");
   return springs->springs();
+}
+
+// The largest strain (l - l0) / l0 of the world's "springs" (0 if none is stretched).
+inline double largest_strain(World& world) {
+  const SpringSet& s = springs_of(world);
+  double worst = 0.0;
+  for (size_t k = 0; k < s.size(); ++k) {
+    const double l = (world.particles.x.col(s.j(k)) - world.particles.x.col(s.i(k))).norm();
+    worst = std::max(worst, (l - s.l0(k)) / s.l0(k));
+  }
+  return worst;
 }
 
 // Kinetic plus potential energy [J].

@@ -225,11 +225,17 @@ TEST_CASE("scene error: a solver iteration limit for the default method") {
 TEST_CASE("scene error: substeps for a method other than xpbd") {
   check_bad_scene("substeps_without_xpbd.toml");
 }
-TEST_CASE("scene error: projection iterations for a method other than xpbd") {
+TEST_CASE("scene error: iterations for a method other than xpbd or local-global") {
   check_bad_scene("iterations_without_xpbd.toml");
 }
 TEST_CASE("scene error: xpbd with 0 substeps") {
   check_bad_scene("zero_substeps.toml");
+}
+TEST_CASE("scene error: local-global with 0 iterations") {
+  check_bad_scene("zero_iterations_local_global.toml");
+}
+TEST_CASE("scene error: substeps for local-global") {
+  check_bad_scene("substeps_with_local_global.toml");
 }
 
 // Not finite, or overflowing.
@@ -416,7 +422,7 @@ TEST_CASE("scene error: every bad scene file has a test case") {
   for (const auto& entry : fs::directory_iterator(fs::path(CLOTHLAB_TEST_SCENES) / "bad")) {
     if (entry.path().extension() == ".toml") ++files;
   }
-  CHECK(files == 113);
+  CHECK(files == 115);
 }
 
 TEST_CASE("scene error: a missing file") {

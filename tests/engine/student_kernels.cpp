@@ -24,6 +24,29 @@ std::string stops_at(F&& run) {
   return "";
 }
 
+// One 1 kg particle on a spring (ks = 100 N/m, l0 = 1 m, stretched to 1.5 m, no damper) from a
+// pinned one, no other force, stepped by `method` at dt = 0.01 s.
+std::string one_spring(const std::string& method) {
+  return R"(
+[[particle]]
+position = [0.0, 0.0, 0.0]
+mass = 1.0
+pinned = true
+[[particle]]
+position = [1.5, 0.0, 0.0]
+mass = 1.0
+[[spring]]
+i = 0
+j = 1
+ks = 100.0
+l0 = 1.0
+[integrator]
+dt = 0.01
+duration = 1
+method = ")" +
+         method + "\"\n";
+}
+
 }  // namespace
 
 TEST_CASE("student build: [self_collision] calls the student's kernels (ex10.1, ex10.2)") {
@@ -91,27 +114,17 @@ duration = 1
 TEST_CASE("student build: method = \"xpbd\" projects with the student's kernel (ex12.1)") {
   // One spring without a damper and no other force: nothing in the substep calls a kernel of
   // lessons 01 to 11 before the first projection, the student's xpbd_distance_projection.
-  clothlab::Scene scene = clothlab::parse_scene(R"(
-[[particle]]
-position = [0.0, 0.0, 0.0]
-mass = 1.0
-pinned = true
-[[particle]]
-position = [1.5, 0.0, 0.0]
-mass = 1.0
-[[spring]]
-i = 0
-j = 1
-ks = 100.0
-l0 = 1.0
-[integrator]
-method = "xpbd"
-dt = 0.01
-duration = 1
-)",
-                                                "stubs.toml");
+  clothlab::Scene scene = clothlab::parse_scene(one_spring("xpbd"), "stubs.toml");
   // The integrator's advance, as World::step calls it (the step itself first asks the guard for
   // the springs' energy, lesson 02's ex02.2).
   clothlab::World& w = scene.world;
   CHECK(stops_at([&] { w.integrator->advance(w, scene.dt); }) == "ex12.1");
+}
+
+TEST_CASE("student build: method = \"local-global\" projects with the student's kernel (ex13.1)") {
+  // The same spring: the step factors its matrix (no kernel) and then calls, first of all
+  // kernels, the student's local_step_projection.
+  clothlab::Scene scene = clothlab::parse_scene(one_spring("local-global"), "stubs.toml");
+  clothlab::World& w = scene.world;
+  CHECK(stops_at([&] { w.integrator->advance(w, scene.dt); }) == "ex13.1");
 }

@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "clothlab/bodies/cloth.hpp"
+#include "clothlab/core/game_loop.hpp"
 #include "clothlab/core/world.hpp"
 #include "clothlab/forces/gravity.hpp"
 #include "clothlab/forces/spring_damper.hpp"
@@ -109,6 +110,96 @@ duration = 1.5
 inline void run_to_end(clothlab::Scene& scene) {
   for (long s = 0; s < scene.step_count(); ++s)
     scene.world.step(scene.dt);
+}
+
+// ---- Methods that take whole steps their own way (lessons 12 and 13) -------------------------
+
+// A stiff sheet of 10 x 10 particles 5 cm apart, 1 g each, ks = 5000 N/m, at dt = 1/60 s with
+// `method`: dt w ~ 75, far past any explicit method's limit (about 2).
+inline std::string stiff_sheet(const std::string& method) {
+  return R"(
+[cloth]
+rows = 10
+cols = 10
+spacing = 0.05
+mass = 0.1
+pins = "top-corners"
+[springs]
+ks = 5000
+kd = 0.01
+[gravity]
+[integrator]
+dt = 0.016666666666666666
+duration = 2
+method = ")" +
+         method + "\"\n";
+}
+
+// An 8 x 8 cloth falling on a sphere (centre (0, 0.5, 0), radius 0.3) above the ground y = 0, with
+// bending springs, for 2 s at dt = 0.01 s; `integrator_keys` go into its [integrator] table.
+inline std::string drape(const std::string& integrator_keys) {
+  return R"(
+[cloth]
+rows = 8
+cols = 8
+spacing = 0.1
+origin = [-0.35, 1.0, -0.35]
+plane = "horizontal"
+mass = 0.2
+[springs]
+ks = 2000
+kd = 0.02
+[bending]
+ks = 10
+[gravity]
+[sphere]
+centre = [0, 0.5, 0]
+radius = 0.3
+[ground]
+y = 0
+e = 0
+mu_s = 0.5
+mu_d = 0.4
+[integrator]
+dt = 0.01
+duration = 2
+)" + integrator_keys;
+}
+
+// The scene `text` stepped 200 times with and without the fast path: the same state, bit for
+// bit, and the fast path took no step and no force sum (it takes whole steps for the Euler
+// methods only).
+inline void check_fast_path_declines(const std::string& text) {
+  clothlab::Scene fast = clothlab::parse_scene(text, "fast.toml");
+  clothlab::Scene readable = clothlab::parse_scene(text, "readable.toml");
+  readable.world.backend.reset();
+  REQUIRE(fast.world.backend != nullptr);
+  clothlab::StepTimes times;
+  fast.world.timing = &times;
+  for (int s = 0; s < 200; ++s) {
+    fast.world.step(fast.dt);
+    readable.world.step(readable.dt);
+  }
+  CHECK(times.backend_steps == 0.0);
+  CHECK(fast.world.fast_evaluations == 0);
+  const bool same_x = fast.world.particles.x == readable.world.particles.x;
+  const bool same_v = fast.world.particles.v == readable.world.particles.v;
+  CHECK(same_x);
+  CHECK(same_v);
+}
+
+// The game loop (lesson 11) on the scene `text`: one frame of 0.1 s and six of 1/60 s both take
+// 500 steps of 0.2 ms and end with the same positions, bit for bit.
+inline void check_frames_do_not_matter(const std::string& text) {
+  clothlab::Simulation one(clothlab::parse_scene(text, "one.toml"), 100000);
+  clothlab::Simulation many(clothlab::parse_scene(text, "many.toml"), 100000);
+  one.advance(0.1);
+  for (int k = 0; k < 6; ++k)
+    many.advance(1.0 / 60.0);
+  REQUIRE(one.steps() == 500);
+  REQUIRE(many.steps() == 500);
+  const bool same = one.positions() == many.positions();
+  CHECK(same);
 }
 
 // ---- Finding effects ------------------------------------------------------------------------

@@ -179,27 +179,9 @@ TEST_CASE("xpbd: a stiff cloth is stable at a step where explicit Euler blows up
   // so its springs give w ~ sqrt(4 ks / m) ~ 4500 rad/s, and dt w ~ 75, far past any explicit
   // method's limit (about 2). Explicit Euler is stopped by the guard; XPBD with 10 substeps runs
   // the 2 s and ends with no more energy than gravity gave it.
-  const auto sheet = [](const std::string& method) {
-    return R"(
-[cloth]
-rows = 10
-cols = 10
-spacing = 0.05
-mass = 0.1
-pins = "top-corners"
-[springs]
-ks = 5000
-kd = 0.01
-[gravity]
-[integrator]
-dt = 0.016666666666666666
-duration = 2
-method = ")" +
-           method + "\"\n";
-  };
-  clothlab::Scene euler = clothlab::parse_scene(sheet("explicit-euler"), "stiff.toml");
+  clothlab::Scene euler = clothlab::parse_scene(test::stiff_sheet("explicit-euler"), "stiff.toml");
   CHECK_THROWS_AS(test::run_to_end(euler), clothlab::SimulationError);
-  clothlab::Scene xpbd = clothlab::parse_scene(sheet("xpbd"), "stiff.toml");
+  clothlab::Scene xpbd = clothlab::parse_scene(test::stiff_sheet("xpbd"), "stiff.toml");
   const double e0 = xpbd.world.kinetic_energy() + xpbd.world.potential_energy();
   CHECK_NOTHROW(test::run_to_end(xpbd));
   // The sheet falls at most its own diagonal plus the springs' stretch: 0.64 m at the most; its
@@ -293,35 +275,7 @@ TEST_CASE(
 }
 
 TEST_CASE("xpbd: scenes read substeps and iterations and run with pins and colliders") {
-  const std::string text = R"(
-[cloth]
-rows = 8
-cols = 8
-spacing = 0.1
-origin = [-0.35, 1.0, -0.35]
-plane = "horizontal"
-mass = 0.2
-[springs]
-ks = 2000
-kd = 0.02
-[bending]
-ks = 10
-[gravity]
-[sphere]
-centre = [0, 0.5, 0]
-radius = 0.3
-[ground]
-y = 0
-e = 0
-mu_s = 0.5
-mu_d = 0.4
-[integrator]
-method = "xpbd"
-substeps = 8
-iterations = 2
-dt = 0.01
-duration = 2
-)";
+  const std::string text = test::drape("method = \"xpbd\"\nsubsteps = 8\niterations = 2\n");
   clothlab::Scene scene = clothlab::parse_scene(text, "drape.toml");
   auto* xpbd = dynamic_cast<Xpbd*>(scene.world.integrator.get());
   REQUIRE(xpbd != nullptr);
@@ -364,34 +318,9 @@ TEST_CASE("xpbd: the fast path leaves the step to the readable code, with the sa
   // FastEngine takes whole steps for the Euler methods only; an XPBD step sums its external
   // forces effect by effect itself. With and without the backend: the same state, bit for bit,
   // and the backend took no step and no force sum.
-  const std::string text = test::storm() + "method = \"xpbd\"\n";
-  clothlab::Scene fast = clothlab::parse_scene(text, "storm.toml");
-  clothlab::Scene readable = clothlab::parse_scene(text, "storm.toml");
-  readable.world.backend.reset();
-  REQUIRE(fast.world.backend != nullptr);
-  clothlab::StepTimes times;
-  fast.world.timing = &times;
-  for (int s = 0; s < 200; ++s) {
-    fast.world.step(fast.dt);
-    readable.world.step(readable.dt);
-  }
-  CHECK(times.backend_steps == 0.0);
-  CHECK(fast.world.fast_evaluations == 0);
-  const bool same_x = fast.world.particles.x == readable.world.particles.x;
-  const bool same_v = fast.world.particles.v == readable.world.particles.v;
-  CHECK(same_x);
-  CHECK(same_v);
+  test::check_fast_path_declines(test::storm() + "method = \"xpbd\"\n");
 }
 
 TEST_CASE("xpbd: the game loop drives an XPBD scene the same for any split into frames") {
-  const std::string text = test::storm() + "method = \"xpbd\"\nsubsteps = 4\n";
-  clothlab::Simulation one(clothlab::parse_scene(text, "storm.toml"), 100000);
-  clothlab::Simulation many(clothlab::parse_scene(text, "storm.toml"), 100000);
-  one.advance(0.1);
-  for (int k = 0; k < 6; ++k)
-    many.advance(1.0 / 60.0);
-  REQUIRE(one.steps() == 500);
-  REQUIRE(many.steps() == 500);
-  const bool same = one.positions() == many.positions();
-  CHECK(same);
+  test::check_frames_do_not_matter(test::storm() + "method = \"xpbd\"\nsubsteps = 4\n");
 }

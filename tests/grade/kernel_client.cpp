@@ -357,4 +357,8 @@ double xpbd_distance_projection(Vec3& x_i, Vec3& x_j, double w_i, double w_j, do
               lambda);
 }
 
+Vec3 local_step_projection(const Vec3& x_i, const Vec3& x_j, double l0, const Vec3& d_previous) {
+  return call(CLOTHLAB_KERNEL(local_step_projection), x_i, x_j, l0, d_previous);
+}
+
 }  // namespace clothlab

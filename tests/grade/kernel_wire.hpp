@@ -58,6 +58,7 @@
 #include "clothlab/forces/gravity.hpp"
 #include "clothlab/forces/spring_damper.hpp"
 #include "clothlab/integrators/euler.hpp"
+#include "clothlab/integrators/local_global.hpp"
 #include "clothlab/integrators/runge_kutta.hpp"
 #include "clothlab/integrators/stability_limit.hpp"
 #include "clothlab/integrators/xpbd.hpp"
@@ -88,7 +89,8 @@ namespace clothlab::wire {
   X(cell_hash)                        \
   X(pair_response)                    \
   X(accumulate)                       \
-  X(xpbd_distance_projection)
+  X(xpbd_distance_projection)         \
+  X(local_step_projection)
 
 #define CLOTHLAB_KERNEL_ENUM(name) name,
 enum class Kernel : std::uint32_t { CLOTHLAB_EXERCISE_KERNELS(CLOTHLAB_KERNEL_ENUM) count };

@@ -4,6 +4,7 @@
 
 #include "clothlab/integrators/euler.hpp"
 #include "clothlab/integrators/implicit_euler.hpp"
+#include "clothlab/integrators/local_global.hpp"
 #include "clothlab/integrators/runge_kutta.hpp"
 #include "clothlab/integrators/verlet.hpp"
 #include "clothlab/integrators/xpbd.hpp"
@@ -15,10 +16,10 @@ namespace {
 constexpr std::array<std::string_view, 7> kNames = {
     "explicit-euler",  "symplectic-euler", "midpoint",      "rk4",
     "velocity-verlet", "position-verlet",  "implicit-euler"};
-// The same and lesson 12's.
-constexpr std::array<std::string_view, 8> kMethods = {
-    "explicit-euler",  "symplectic-euler", "midpoint",       "rk4",
-    "velocity-verlet", "position-verlet",  "implicit-euler", "xpbd"};
+// The same, lesson 12's and lesson 13's.
+constexpr std::array<std::string_view, 9> kMethods = {
+    "explicit-euler",  "symplectic-euler", "midpoint", "rk4",         "velocity-verlet",
+    "position-verlet", "implicit-euler",   "xpbd",     "local-global"};
 }  // namespace
 
 std::span<const std::string_view> integrator_names() {
@@ -38,6 +39,7 @@ std::unique_ptr<Integrator> make_integrator(std::string_view name) {
   if (name == "position-verlet") return std::make_unique<PositionVerlet>();
   if (name == "implicit-euler") return std::make_unique<ImplicitEuler>();
   if (name == "xpbd") return std::make_unique<Xpbd>();
+  if (name == "local-global") return std::make_unique<LocalGlobal>();
   return nullptr;
 }
 

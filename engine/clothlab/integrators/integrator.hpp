@@ -32,8 +32,9 @@ class Integrator {
 // give in [integrator] method = "...", but for the methods of method_names() alone.
 std::span<const std::string_view> integrator_names();
 
-// Every name a scene may give in [integrator] method = "...": integrator_names() and lesson 12's
-// position-based "xpbd", which moves particles by constraints instead of by spring forces.
+// Every name a scene may give in [integrator] method = "...": integrator_names(), lesson 12's
+// position-based "xpbd", which moves particles by constraints instead of by spring forces, and
+// lesson 13's "local-global", which solves implicit Euler by projections and a prefactored system.
 std::span<const std::string_view> method_names();
 
 // The integrator called `name`, or nullptr when there is none by that name.
