@@ -127,17 +127,6 @@ void convergence() {
   fmt::print("\n");
 }
 
-// The largest strain (l - l0) / l0 of the scene's springs.
-double max_strain(World& world) {
-  const SpringSet& s = springs_of(world);
-  double worst = 0.0;
-  for (size_t k = 0; k < s.size(); ++k) {
-    const double l = (world.particles.x.col(s.j(k)) - world.particles.x.col(s.i(k))).norm();
-    worst = std::max(worst, (l - s.l0(k)) / s.l0(k));
-  }
-  return worst;
-}
-
 void stiff_curtain() {
   fmt::print(
       "4. stiff-curtain.toml: lesson 08's stiff sheet (ks = 20000 N/m) at dt = 1/60 s for 4 s\n");
@@ -169,7 +158,7 @@ void stiff_curtain() {
       continue;
     }
     fmt::print("   {:<34}  {:>13.3f}%  {:>12.4f}  {:>10.2f}\n", v.name,
-               max_strain(scene.world) * 100.0, energy(scene.world), seconds_since(start));
+               largest_strain(scene.world) * 100.0, energy(scene.world), seconds_since(start));
   }
 }
 
