@@ -127,8 +127,11 @@ template <bool Uniform, bool UpperIsJ, bool ToUpper, bool ToLower>
     double* f_upper, double* f_lower) {
   // No two springs the compiler takes at once touch the same particle (see kDirectGap). Clang
   // says so when it cannot vectorise the loop anyway, which is the case whenever the kernel is
-  // not inlined (a build without link-time optimisation): no reason for a warning.
-#if defined(__clang__)
+  // not inlined (a build without link-time optimisation): no reason for a warning. A
+  // WebAssembly module without SIMD (engine/web/) has nothing to vectorise with, and there the
+  // link-time optimiser would say so past the pragma below: no hint at all.
+#if defined(__wasm__) && !defined(__wasm_simd128__)
+#elif defined(__clang__)
 #pragma clang diagnostic push
 #pragma clang diagnostic ignored "-Wpass-failed"
 #pragma clang loop vectorize(assume_safety)
@@ -155,7 +158,7 @@ template <bool Uniform, bool UpperIsJ, bool ToUpper, bool ToLower>
       f_j[2 * n + t] -= f1.z();
     }
   }
-#if defined(__clang__)
+#if defined(__clang__) && !(defined(__wasm__) && !defined(__wasm_simd128__))
 #pragma clang diagnostic pop
 #endif
 }
