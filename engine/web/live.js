@@ -489,6 +489,16 @@
   }
 
   // --- Start ------------------------------------------------------------------------------
+  // The module steps two doubles an instruction with WebAssembly SIMD (engine/web/CMakeLists.txt):
+  // a browser without it could not compile it. Asked first with a module of one function that
+  // returns f64x2.splat(0), so that such a browser says what it lacks.
+  const simd = new Uint8Array([0, 97, 115, 109, 1, 0, 0, 0, 1, 5, 1, 96, 0, 1, 123, 3, 2, 1, 0,
+    10, 15, 1, 13, 0, 68, 0, 0, 0, 0, 0, 0, 0, 0, 253, 20, 11]);
+  if (typeof WebAssembly !== 'object' || !WebAssembly.validate(simd)) {
+    showMessage('This page needs WebAssembly with SIMD, which this browser lacks: open it in ' +
+      'Chromium or Chrome 91, Firefox 89, Safari 16.4 or later.', 'error');
+    return;
+  }
   createClothlab().then((m) => {
     module = m;
     api = bind(m);

@@ -5,7 +5,8 @@ the motion, a drag moves the grabbed particle, an edited scene's error shows FIL
 strain at each particle comes from the engine, a slider keeps a cloth's tears, the engine names
 its planes, and side by side the same build never differs while a particle moved in one alone is
 the first difference (and, on a student page built on the stubs, the exercise's message, and the
-frame where the stub stops as the first difference from the reference)."""
+frame where the stub stops as the first difference from the reference). And a browser without
+WebAssembly SIMD, which the module needs, is told so in the page."""
 
 import argparse
 import base64
@@ -82,6 +83,23 @@ def check(page: pathlib.Path, test_script: str, work: pathlib.Path) -> list:
     return problems
 
 
+def check_without_simd(page: pathlib.Path, work: pathlib.Path) -> list:
+    """The page in a browser that cannot compile SIMD (every WebAssembly module found invalid,
+    as such a browser finds the engine's) says what it lacks instead of failing silently."""
+    text = page.read_text(encoding="utf-8").replace(
+        "<head>", "<head>\n<script>WebAssembly.validate = () => false;</script>", 1)
+    copy = work / ("no-simd-" + page.name)
+    copy.write_text(text, encoding="utf-8")
+    command = [browser(), "--headless", "--no-sandbox", "--disable-dev-shm-usage",
+               "--disable-3d-apis", "--dump-dom", copy.resolve().as_uri()]
+    dom = subprocess.run(command, capture_output=True, text=True, timeout=120).stdout
+    found = re.search(r'<div id="message"[^>]*>([^<]*)<', dom)
+    message = found.group(1) if found else "(no message box)"
+    ok = "WebAssembly with SIMD" in message
+    print(f"  {'ok  ' if ok else 'FAIL'} {page.name}: without WebAssembly SIMD, the page says so")
+    return [] if ok else [f"{page.name}: without WebAssembly SIMD the page said: {message}"]
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__)
     parser.add_argument("pages", nargs="+", type=pathlib.Path)
@@ -91,6 +109,7 @@ def main() -> None:
     with tempfile.TemporaryDirectory(prefix="clothlab-pages-") as work:
         for page in args.pages:
             problems += check(page, test_script, pathlib.Path(work))
+        problems += check_without_simd(args.pages[0], pathlib.Path(work))
     for p in problems:
         print(p, file=sys.stderr)
     sys.exit(1 if problems else 0)

@@ -63,6 +63,18 @@
       if (ok) {
         say(`${scene.name}: simulated time advances`, api.time() >= t0 + span - api.dt() - 1e-9,
             `t = ${api.time()} after ${span} s of frames (dt = ${api.dt()})`);
+        // The module's fast path (built with SIMD) and the lecture's readable path give the
+        // same state, bit for bit, as they do natively (tests/fast/).
+        const fast = page.positions(), steps = api.steps();
+        page.load(`${scene.text}\n[engine]\nfast_path = false\n`, scene.name);
+        page.setRunning(false);
+        for (let k = 0; k < 600 && api.steps() < steps && ok; ++k) ok = page.advance(1 / 60);
+        const readable = page.positions();
+        const differ = readable.findIndex((value, k) => value !== fast[k]);
+        say(`${scene.name}: the fast path and the readable path agree bit for bit`,
+            ok && api.steps() === steps && readable.length === fast.length && differ < 0,
+            `${api.steps()} steps against ${steps}; ${differ < 0 ? 'no difference' :
+              `coordinate ${differ}: ${readable[differ]} against ${fast[differ]}`}; ${page.message()}`);
       } else {
         // A scene that blows up on purpose (lesson 08) stops with the guard's message.
         say(`${scene.name}: the run stops with the guard's message`,
