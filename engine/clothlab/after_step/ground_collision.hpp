@@ -69,6 +69,7 @@ class Ground final : public PostStepEffect {
       : y0_(y0), material_(material), model_(model), friction_(friction) {}
   std::string_view name() const override { return "ground"; }
   void before_step(const World& world) override { start_.record(world); }
+  bool each_substep() const override { return true; }
   void apply(World& world, double dt) override;
   // apply's loop on particles [begin, end) only: each particle is pushed out from its own state
   // alone, so ranges may be taken apart (and by different threads at once).
@@ -94,6 +95,7 @@ class Plane final : public PostStepEffect {
         material_(material) {}
   std::string_view name() const override { return "plane"; }
   void before_step(const World& world) override { start_.record(world); }
+  bool each_substep() const override { return true; }
   void apply(World& world, double dt) override;
   void collide(Particles& p, Index begin, Index end) const;
   const Vec3& point() const { return point_; }
@@ -113,6 +115,7 @@ class Sphere final : public PostStepEffect {
       : centre_(centre), radius_(radius), material_(material) {}
   std::string_view name() const override { return "sphere"; }
   void before_step(const World& world) override { start_.record(world); }
+  bool each_substep() const override { return true; }
   void apply(World& world, double dt) override;
   // apply's loop on particles [begin, end) only (as Ground::collide).
   void collide(Particles& p, Index begin, Index end) const;

@@ -102,6 +102,14 @@ class PostStepEffect {
   // The energy [J] this effect can give the particles, as ForceEffect::energy_scale says: a pin
   // that moves can drive them.
   virtual double energy_scale(const Particles& /*p*/, double /*size*/) const { return 0.0; }
+
+  // True for a contact with a fixed solid (the ground, a plane, a sphere), which changes each
+  // particle from that particle's own state alone. An integrator that splits its step into
+  // substeps (XPBD, lesson 12) treats each substep as a step for such an effect: before_step at
+  // the substep's start, apply at its end, so that the cloth meets the solid within a substep
+  // rather than a whole step late. (The world still applies it after the step, as always: that
+  // is the last substep's.) Tearing, plasticity and the others see whole steps.
+  virtual bool each_substep() const { return false; }
 };
 
 }  // namespace clothlab

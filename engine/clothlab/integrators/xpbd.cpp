@@ -1,7 +1,9 @@
 #include "clothlab/integrators/xpbd.hpp"
 
 #include <algorithm>
+#include <vector>
 
+#include "clothlab/core/effect.hpp"
 #include "clothlab/core/world.hpp"
 #include "clothlab/forces/spring_damper.hpp"
 
@@ -49,8 +51,19 @@ void Xpbd::advance(World& world, double dt) {
     }
   }
   lambda_.resize(constraints);
+  // The contacts with fixed solids ([ground], [[plane]], [sphere]), which meet the cloth in every
+  // substep (PostStepEffect::each_substep): here after each substep but the last, whose
+  // contacts World::step applies with the other post-step effects.
+  std::vector<PostStepEffect*> contacts;
+  for (const auto& effect : world.post_step_effects) {
+    if (effect->each_substep()) contacts.push_back(effect.get());
+  }
 
   for (int s = 0; s < substeps; ++s) {
+    if (s > 0) {
+      for (PostStepEffect* contact : contacts)
+        contact->before_step(world);  // the substep's start, as World::step does for the step's
+    }
     // External forces at the substep's start (gravity, wind, drag, a game's push, ...).
     f_ext_.setZero();
     ++world.force_evaluations;  // one sum of the external forces a substep (reports)
@@ -104,6 +117,10 @@ void Xpbd::advance(World& world, double dt) {
 
     // The velocity the particles moved at over the substep.
     p.v = (p.x - x_old_) / h;
+    if (s + 1 < substeps) {
+      for (PostStepEffect* contact : contacts)
+        contact->apply(world, h);
+    }
   }
 }
 

@@ -30,6 +30,9 @@
 //   x      = x + dt_s v + dt_s^2 w f_ext                          the prediction x*
 //   repeat `iterations` times: project every constraint (above), in order
 //   v      = (x - x_old) / dt_s
+//   the contacts with fixed solids ([ground], [[plane]], [sphere]), as after a step
+// (PostStepEffect::each_substep; World::step applies the last substep's with the other post-step
+// effects, which see whole steps: tearing, plasticity, strain limiting, self-collision).
 // A pinned particle has w = 0: the prediction moves it by dt_s v only (a moving pin's velocity)
 // and no projection moves it.
 #pragma once
