@@ -22,6 +22,19 @@ def script_text(path: pathlib.Path) -> str:
     return text
 
 
+def reference_script(path: pathlib.Path) -> str:
+    """The reference module (the lesson page's own, built on solutions/) for a student page's
+    side-by-side mode. It names its factory createClothlab, as the student's module does: run
+    inside a function, its name stays there, and the function hands the factory out as
+    createClothlabReference. One module linked once serves both pages."""
+    text = script_text(path)
+    if not re.search(r"\bvar createClothlab\b", text):
+        sys.exit(f"make_page: {path} does not define createClothlab (built with another "
+                 "EXPORT_NAME?)")
+    return ("<script>\nvar createClothlabReference = (function () {\n" + text +
+            "\nreturn createClothlab;\n})();\n</script>")
+
+
 def safe_json(value) -> str:
     """JSON whose <, > and & are \\u escapes: no text in it can end the <script> it sits in."""
     text = json.dumps(value, ensure_ascii=False)
@@ -37,8 +50,9 @@ def main() -> None:
     for option in ("lesson", "shell", "script", "render", "three", "orbit", "module", "out",
                    "kernels"):
         parser.add_argument(f"--{option}", required=True)
-    parser.add_argument("--reference", help="the reference module, for a student page's "
-                        "side-by-side mode (its factory is createClothlabReference)")
+    parser.add_argument("--reference", help="the reference module (the lesson page's), for a "
+                        "student page's side-by-side mode, where its factory is "
+                        "createClothlabReference")
     args = parser.parse_args()
 
     lesson = pathlib.Path(args.lesson)
@@ -64,8 +78,8 @@ def main() -> None:
                                      script_text(pathlib.Path(args.orbit)) + "</script>",
         "<!--CLOTHLAB_MODULE-->": "<script>" + script_text(pathlib.Path(args.module)) +
                                   "</script>",
-        "<!--CLOTHLAB_REFERENCE-->": ("<script>" + script_text(pathlib.Path(args.reference)) +
-                                      "</script>") if args.reference else "",
+        "<!--CLOTHLAB_REFERENCE-->": reference_script(pathlib.Path(args.reference))
+                                     if args.reference else "",
         "<!--CLOTHLAB_RENDER-->": "<script>" + script_text(pathlib.Path(args.render)) +
                                   "</script>",
         "<!--CLOTHLAB_SCRIPT-->": "<script>" + script_text(pathlib.Path(args.script)) +
