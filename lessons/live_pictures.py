@@ -42,7 +42,7 @@ def main():
             continue
         page = pages / f"{lesson}.html"
         out = lessons / lesson / "live.png"
-        url = f"{page.resolve().as_uri()}#scene={scene}&t={t}"
+        url = f"{page.resolve().as_uri()}#scene={scene}&t={t}&paused"
         subprocess.run([browser, "--headless", "--no-sandbox", "--use-angle=swiftshader",
                         "--enable-unsafe-swiftshader", "--hide-scrollbars",
                         "--window-size=1280,720", "--virtual-time-budget=3000",

@@ -17,6 +17,7 @@
   let running = true;
   let failed = false;
   let parameters = [];  // the numbers of the scene (clothlab_parameters)
+  const pageTitle = document.title;  // the lesson's; the scene's name goes before it
   const stats = { steps: 0, stepMs: 0, frames: 0 };
 
   function bind(m) {
@@ -101,6 +102,7 @@
     if (!check(status)) return false;
     sceneText = text;
     loadedText = text;
+    document.title = `${name.split('/').pop()}: ${pageTitle}`;
     parameters = JSON.parse(api.parameters());
     stats.steps = 0;
     energy.clear();
@@ -172,15 +174,35 @@
     return { to: (s) => -span + 2 * span * s, from: (x) => (x + span) / (2 * span) };
   }
 
+  // A slider's label under its table's heading: `aerodynamics.wind[2]` is `wind z` under
+  // `aerodynamics` (a vector of three is x, y, z), `springs.ks` is `ks` under `springs`.
+  function sliderLabel(name) {
+    const dot = name.indexOf('.');
+    const key = name.slice(dot + 1);
+    const element = /^(.*)\[(\d)\]$/.exec(key);
+    if (!element) return key;
+    const size = parameters.filter((q) => q.name.startsWith(`${name.slice(0, name.lastIndexOf('['))}[`)).length;
+    return size === 3 ? `${element[1]} ${'xyz'[Number(element[2])]}` : key;
+  }
+
   function buildSliders() {
     const box = $('sliders');
     box.textContent = '';
+    let table = '';
     for (const p of parameters) {
       if (!kSliderTables.test(p.name) || p.integer) continue;
+      const heading = p.name.slice(0, p.name.indexOf('.'));
+      if (heading !== table) {
+        table = heading;
+        const title = document.createElement('div');
+        title.className = 'slider-table';
+        title.textContent = `[${heading}]`;
+        box.append(title);
+      }
       const row = document.createElement('label');
       row.className = 'slider';
       const name = document.createElement('span');
-      name.textContent = p.name;
+      name.textContent = sliderLabel(p.name);
       name.title = p.name;
       const input = document.createElement('input');
       input.type = 'range';
@@ -480,12 +502,16 @@
     view.update();
     view.draw();
     energy.draw();
+    showStats();
+    requestAnimationFrame(frame);
+  }
+
+  function showStats() {
     const stepsPerSecond = stats.stepMs > 0 ? 1000 / stats.stepMs : 0;
     $('overlay').textContent =
       `t = ${api.time().toFixed(3)} s   steps ${stats.steps}\n` +
       `${stats.stepMs > 0 ? `${stats.stepMs.toFixed(3)} ms per step (${Math.round(stepsPerSecond)} steps/s)` : 'ms per step: not measured yet'}   ` +
       `${api.particles()} particles   ${view.kind}`;
-    requestAnimationFrame(frame);
   }
 
   // --- Start ------------------------------------------------------------------------------
@@ -510,13 +536,16 @@
     setupDisplay();
     setupCompare();
     setupMouse();
-    // The address may name the scene and a time to start from: page.html#scene=flag.toml&t=2.
+    // The address may name the scene and a time to start from, and ask to wait there paused:
+    // page.html#scene=flag.toml&t=2 (and &paused).
     const wish = new URLSearchParams(location.hash.slice(1));
     const first = lesson.scenes.find((s) => s.name.endsWith('/' + wish.get('scene'))) || lesson.scenes[0];
     $('scene').value = first.name;
     load(first.text, first.name);
     const start = Number(wish.get('t'));
     for (let t = 0; start > 0 && t < start - 1e-9 && !failed; t += 1 / 60) advance(Math.min(1 / 60, start - t));
+    if (wish.has('paused')) setRunning(false);
+    showStats();
     requestAnimationFrame(frame);
     // For tests and for the curious: the page's own functions.
     window.clothlabPage = {

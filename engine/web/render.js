@@ -25,6 +25,18 @@ const ClothlabRender = (function () {
     return { centre: lo.map((l, a) => (l + hi[a]) / 2), size, lo, hi };
   }
 
+  // The box the camera frames when a source gives none: the first positions and, where the
+  // scene has a ground not far below them (within three times their size), the ground too, so
+  // that what falls on it stays in view (lesson 09's jelly cube, dropped from 0.5 m).
+  function framed(source) {
+    const box = bounds(source.positions());
+    const ground = source.colliders().ground;
+    if (ground === null || ground === undefined || !(ground < box.lo[1]) || box.lo[1] - ground > 3 * box.size) return box;
+    const lo = [box.lo[0], ground, box.lo[2]];
+    const size = Math.max(box.size, box.hi[1] - ground);
+    return { centre: lo.map((l, a) => (l + box.hi[a]) / 2), size, lo, hi: box.hi };
+  }
+
   // Strain to colour: unstrained is pale, stretched red, squeezed blue, full at +-scale.
   function strainColour(e, scale, out, at) {
     const s = Math.max(-1, Math.min(1, e / scale));
@@ -152,7 +164,7 @@ const ClothlabRender = (function () {
       clear();
       sources = list;
       bodies = list.map(makeBody);
-      const box = list[0].bounds ? list[0].bounds() : bounds(list[0].positions());
+      const box = list[0].bounds ? list[0].bounds() : framed(list[0]);
       const colliders = list[0].colliders();
       const groundY = colliders.ground !== null && colliders.ground !== undefined
         ? colliders.ground : box.lo[1] - 0.5 * box.size;
@@ -316,7 +328,7 @@ const ClothlabRender = (function () {
     return {
       kind: '2d',
       settings,
-      rebuild(list) { sources = list; box = bounds(list[0].positions()); },
+      rebuild(list) { sources = list; box = list[0].bounds ? list[0].bounds() : framed(list[0]); },
       update() {},
       draw() {
         canvas.width = canvas.clientWidth;

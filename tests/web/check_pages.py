@@ -1,12 +1,13 @@
 #!/usr/bin/env python3
 """Opens each live lesson page in headless Chromium with page_test.js put into a copy of it, and
 checks what the test found: no console error, time advances in every scene, a slider changes
-the motion, a drag moves the grabbed particle, an edited scene's error shows FILE:LINE:COL, the
+the motion (and each is labelled apart from the others under its table), a drag moves the grabbed particle, an edited scene's error shows FILE:LINE:COL, the
 strain at each particle comes from the engine, a slider keeps a cloth's tears, the engine names
 its planes, and side by side the same build never differs while a particle moved in one alone is
 the first difference (and, on a student page built on the stubs, the exercise's message, and the
 frame where the stub stops as the first difference from the reference). And a browser without
-WebAssembly SIMD, which the module needs, is told so in the page."""
+WebAssembly SIMD, which the module needs, is told so in the page; and an address that names a
+scene, a time and `paused` opens the page there."""
 
 import argparse
 import base64
@@ -100,6 +101,46 @@ def check_without_simd(page: pathlib.Path, work: pathlib.Path) -> list:
     return [] if ok else [f"{page.name}: without WebAssembly SIMD the page said: {message}"]
 
 
+def last_scene(page: pathlib.Path) -> str:
+    """The file name of the last scene a page carries (the first is shown by default)."""
+    text = page.read_text(encoding="utf-8")
+    names = re.findall(r'"name": "[^"]*/([^"/]+\.toml)"', text)
+    if not names:
+        sys.exit(f"check_pages: {page.name} carries no scene")
+    return names[-1]
+
+
+ADDRESS_PROBE = """<script>
+document.addEventListener('clothlab-ready', () => setTimeout(() => {
+  const page = window.clothlabPage;
+  const overlay = document.getElementById('overlay').textContent;
+  const seen = { title: document.title, time: page.api.time(), dt: page.api.dt(), overlay,
+                 play: document.getElementById('play').textContent,
+                 shown: overlay.startsWith(`t = ${page.api.time().toFixed(3)} s`) };
+  console.log('CLOTHLAB-ADDRESS ' + btoa(JSON.stringify(seen)));
+}, 1000));
+</script>"""
+
+
+def check_address(page: pathlib.Path, scene: str, work: pathlib.Path) -> list:
+    """The address names a scene and a time, and asks to wait there paused (as the lessons'
+    screenshots are taken): a second later the page shows that scene at that time."""
+    text = page.read_text(encoding="utf-8").replace("</body>", ADDRESS_PROBE + "\n</body>", 1)
+    copy = work / ("address-" + page.name)
+    copy.write_text(text, encoding="utf-8")
+    url = f"{copy.resolve().as_uri()}#scene={scene}&t=0.5&paused"
+    command = [browser(), "--headless", "--no-sandbox", "--disable-dev-shm-usage",
+               "--use-angle=swiftshader", "--enable-unsafe-swiftshader",
+               "--enable-logging=stderr", "--v=0", url]
+    seen = run_until_reported(command, "CLOTHLAB-ADDRESS ", timeout=120) or {}
+    # The game loop takes whole steps: the time reached is within a step below 0.5 s.
+    time, dt = seen.get("time", -1), seen.get("dt", 0)
+    ok = (0.5 - dt - 1e-9 <= time <= 0.5 + 1e-9 and seen.get("play") == "Play" and
+          seen.get("title", "").startswith(scene + ":") and seen.get("shown"))
+    print(f"  {'ok  ' if ok else 'FAIL'} {page.name}: #scene={scene}&t=0.5&paused waits at t = 0.5 s")
+    return [] if ok else [f"{page.name}: #scene={scene}&t=0.5&paused shows {seen}"]
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__)
     parser.add_argument("pages", nargs="+", type=pathlib.Path)
@@ -110,6 +151,9 @@ def main() -> None:
         for page in args.pages:
             problems += check(page, test_script, pathlib.Path(work))
         problems += check_without_simd(args.pages[0], pathlib.Path(work))
+        # (A student page on the stubs stops at its first step: its address is the same code.)
+        for page in (p for p in args.pages if not p.stem.endswith("-student")):
+            problems += check_address(page, last_scene(page), pathlib.Path(work))
     for p in problems:
         print(p, file=sys.stderr)
     sys.exit(1 if problems else 0)

@@ -56,6 +56,15 @@
       const shown = document.getElementById('integrator').value;
       say(`${scene.name}: the integrator menu shows the scene's method`,
           shown === (method ? method[1] : 'symplectic-euler'), shown);
+      // A scene with a ground not far below the cloth is framed down to the ground, so that
+      // what falls on it stays in view: the camera aims halfway between the ground and the top.
+      const ground = api.colliders ? JSON.parse(api.colliders()).ground : null;
+      const box = ClothlabRender.bounds(page.positions());
+      if (ground !== null && ground < box.lo[1] && box.lo[1] - ground <= 3 * box.size && page.view.controls) {
+        const aim = page.view.controls.target.y, halfway = (ground + box.hi[1]) / 2;
+        say(`${scene.name}: the view frames the cloth and the ground below it`,
+            Math.abs(aim - halfway) < 1e-9 * Math.max(1, box.size), `aims at y = ${aim}, not ${halfway}`);
+      }
       // Frames of 1/60 s for a sixth of a second, or three steps of a scene's larger dt.
       const t0 = api.time(), span = Math.max(1 / 6, 3 * api.dt());
       let ok = true;
@@ -103,6 +112,27 @@
       say(`the slider ${name} changes the motion`, changed && diff > 1e-6,
           `max difference ${diff} m; ${page.message()}`);
       say(`the slider ${name} is in the scene's text`, page.sceneText().includes(String(value)), page.sceneText());
+      // Each slider is told apart from the others under its table's heading: no two labels in
+      // one table alike, a vector's elements named by axis, the full name in its tooltip.
+      const labels = new Set();
+      let table = '';
+      const clashes = [];
+      for (const node of document.querySelectorAll('#sliders > *')) {
+        if (node.className === 'slider-table') {
+          table = node.textContent;
+          continue;
+        }
+        const label = node.querySelector('span');
+        const full = node.querySelector('input').dataset.name;
+        const key = `${table} ${label.textContent}`;
+        if (labels.has(key) || label.title !== full || !table.includes(full.split('.')[0])) clashes.push(key);
+        labels.add(key);
+        const axis = /\[(\d)\]$/.exec(full);
+        const vector = page.parameters().filter((q) => q.name.startsWith(full.replace(/\[\d\]$/, '['))).length;
+        if (axis && vector === 3 && !label.textContent.endsWith(` ${'xyz'[Number(axis[1])]}`)) clashes.push(key);
+      }
+      say('each slider has its own label under its table, a vector\'s by axis', clashes.length === 0,
+          clashes.join(', '));
     } else {
       say('the first scene has sliders', false, 'none');
     }
