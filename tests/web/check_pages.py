@@ -1,13 +1,14 @@
 #!/usr/bin/env python3
 """Opens each live lesson page in headless Chromium with page_test.js put into a copy of it, and
-checks what the test found: no console error, time advances in every scene, a slider changes
-the motion (and each is labelled apart from the others under its table), a drag moves the grabbed particle, an edited scene's error shows FILE:LINE:COL, the
-strain at each particle comes from the engine, a slider keeps a cloth's tears, the engine names
-its planes, and side by side the same build never differs while a particle moved in one alone is
-the first difference (and, on a student page built on the stubs, the exercise's message, and the
-frame where the stub stops as the first difference from the reference). And a browser without
-WebAssembly SIMD, which the module needs, is told so in the page; and an address that names a
-scene, a time and `paused` opens the page there."""
+checks what the test found: no console error, time advances in every scene, a scene with a
+ground is framed down to it, a slider changes the motion (and each is labelled apart from the
+others under its table), a drag moves the grabbed particle, an edited scene's error shows
+FILE:LINE:COL, the strain at each particle comes from the engine, a slider keeps a cloth's
+tears, the engine names its planes, and side by side the same build never differs while a
+particle moved in one alone is the first difference (and, on a student page built on the stubs,
+the exercise's message, and the frame where the stub stops as the first difference from the
+reference). And a browser without WebAssembly SIMD, which the module needs, is told so in the
+page; and an address that names a scene, a time and `paused` opens the page there."""
 
 import argparse
 import base64

@@ -58,7 +58,7 @@
           shown === (method ? method[1] : 'symplectic-euler'), shown);
       // A scene with a ground not far below the cloth is framed down to the ground, so that
       // what falls on it stays in view: the camera aims halfway between the ground and the top.
-      const ground = api.colliders ? JSON.parse(api.colliders()).ground : null;
+      const ground = JSON.parse(api.colliders()).ground;
       const box = ClothlabRender.bounds(page.positions());
       if (ground !== null && ground < box.lo[1] && box.lo[1] - ground <= 3 * box.size && page.view.controls) {
         const aim = page.view.controls.target.y, halfway = (ground + box.hi[1]) / 2;
