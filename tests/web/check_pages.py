@@ -61,17 +61,22 @@ def run_until_reported(command: list, tag: str, timeout: float):
         process.wait()
 
 
+def drive(url: str, tag: str, timeout: float):
+    """Opens `url` in headless Chromium with WebGL (SwiftShader) and returns what the page
+    reports on the console line starting with `tag` (None if nothing within `timeout` s)."""
+    command = [browser(), "--headless", "--no-sandbox", "--disable-dev-shm-usage",
+               "--use-angle=swiftshader", "--enable-unsafe-swiftshader",
+               "--window-size=1200,800", "--enable-logging=stderr", "--v=0", url]
+    return run_until_reported(command, tag, timeout)
+
+
 def check(page: pathlib.Path, test_script: str, work: pathlib.Path) -> list:
     text = page.read_text(encoding="utf-8")
     text = text.replace("<head>", "<head>\n" + CAPTURE, 1)
     text = text.replace("</body>", "<script>" + test_script + "</script>\n</body>", 1)
     copy = work / page.name
     copy.write_text(text, encoding="utf-8")
-    command = [browser(), "--headless", "--no-sandbox", "--disable-dev-shm-usage",
-               "--use-angle=swiftshader", "--enable-unsafe-swiftshader",
-               "--window-size=1200,800", "--enable-logging=stderr", "--v=0",
-               copy.resolve().as_uri()]
-    results = run_until_reported(command, "CLOTHLAB-TEST ", timeout=240)
+    results = drive(copy.resolve().as_uri(), "CLOTHLAB-TEST ", timeout=240)
     if results is None:
         return [f"{page.name}: the page reported nothing within 240 s"]
     problems = [f"{page.name}: console error: {e}" for e in results["errors"]]
@@ -130,10 +135,7 @@ def check_address(page: pathlib.Path, scene: str, work: pathlib.Path) -> list:
     copy = work / ("address-" + page.name)
     copy.write_text(text, encoding="utf-8")
     url = f"{copy.resolve().as_uri()}#scene={scene}&t=0.5&paused"
-    command = [browser(), "--headless", "--no-sandbox", "--disable-dev-shm-usage",
-               "--use-angle=swiftshader", "--enable-unsafe-swiftshader",
-               "--enable-logging=stderr", "--v=0", url]
-    seen = run_until_reported(command, "CLOTHLAB-ADDRESS ", timeout=120) or {}
+    seen = drive(url, "CLOTHLAB-ADDRESS ", timeout=120) or {}
     # The game loop takes whole steps: the time reached is within a step below 0.5 s.
     time, dt = seen.get("time", -1), seen.get("dt", 0)
     ok = (0.5 - dt - 1e-9 <= time <= 0.5 + 1e-9 and seen.get("play") == "Play" and
