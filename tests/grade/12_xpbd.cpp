@@ -8,6 +8,7 @@
 // The numbers are chosen so that every value comes out as a short fraction: d = (0, -3, -4) has
 // l = 5 and n = (0, -0.6, -0.8).
 #include <cmath>
+#include <string>
 
 #include "clothlab/integrators/xpbd.hpp"
 #include "grading.hpp"
@@ -189,7 +190,7 @@ TEST_SUITE("ex12") {
     {
       // What a wrong answer here usually is: -1/9 (and the pair pulled closer) without the term
       // -alpha_tilde lambda; -1/3 with nothing moved, the lambda given plus a delta_lambda of 0.
-      const char* mistake =
+      const std::string mistake =
           std::abs(dl2 + 1.0 / 9.0) <= 1e-9
               ? "-1/9 means the term -alpha_tilde lambda is missing (hint 2)"
           : std::abs(dl2 + 1.0 / 3.0) <= 1e-9
