@@ -6,6 +6,8 @@
 #   mutant exNN.k FILE: what the mistake is
 #   - one line of solutions/FILE, as it is (leading spaces aside; it must occur exactly once)
 #   + the line that replaces it
+#   ? an extended regular expression that a line of the grader's output must match (optional,
+#     any number: the hint a lesson promises for this mistake, say)
 #
 # a copy of solutions/FILE with that one line changed, graded on exercise exNN.k alone: it must
 # compile and lose points there (a grading case that still gives full marks cannot tell the
@@ -58,7 +60,6 @@ CMAKE
 grade() {
   local name=$1
   shift
-  local out
   if ! out=$(NO_COLOR=1 "$clothlab" grade --submission "$work/$name" --scratch "$work/scratch" \
     --results "$work/$name.json" --hidden "$@" 2>&1); then
     echo "$out"
@@ -113,7 +114,8 @@ plant_regions() {
 }
 
 # --- read PLANTS into folders to grade ---------------------------------------------------------
-mutants=()     # name|exercise
+mutants=()     # name|exercise|what
+declare -A expect_lines  # name -> the "?" patterns, one a line
 submissions=() # names
 kind="" name="" file="" old=""
 while IFS= read -r line || [[ -n $line ]]; do
@@ -128,6 +130,8 @@ while IFS= read -r line || [[ -n $line ]]; do
     old=${BASH_REMATCH[1]}
   elif [[ $kind == mutant && $line =~ ^\+\ (.*)$ ]]; then
     plant_line "$work/$name/$file" "$old" "${BASH_REMATCH[1]}" || true
+  elif [[ $kind == mutant && $line =~ ^\?\ (.*)$ ]]; then
+    expect_lines[$name]+="${BASH_REMATCH[1]}"$'\n'
   elif [[ $line =~ ^submission\ ([a-z0-9-]+):\ (.*)$ ]]; then
     kind=submission
     name=${BASH_REMATCH[1]}
@@ -183,6 +187,11 @@ for entry in "${mutants[@]}"; do
   elif [[ $score -ge $max ]]; then
     problem "$name ($exercise: $what) keeps full marks, $score / $max"
   fi
+  while IFS= read -r pattern; do
+    [[ -z $pattern ]] && continue
+    grep -Eq -- "$pattern" <<<"$out" ||
+      problem "$name ($exercise: $what): no line of the grader's output matches \"$pattern\""
+  done <<<"${expect_lines[$name]:-}"
 done
 for entry in "${submissions[@]}"; do
   IFS='|' read -r name what <<<"$entry"
