@@ -22,7 +22,7 @@ namespace clothlab {
 //   x_i += w_i delta_lambda n,   x_j -= w_j delta_lambda n;   return delta_lambda
 // Hints:
 //   1. Return 0 and move nothing first for what cannot move: w_i + w_j = 0 (both ends pinned;
-//      with alpha_tilde = 0 the division would be 0 / 0) and l = 0 (no direction n).
+//      with alpha_tilde = 0 the division would be -C / 0) and l = 0 (no direction n).
 //   2. The term -alpha_tilde lambda is what makes XPBD's stiffness independent of the
 //      iterations: lambda is what this constraint has already pushed in this step. Leave it out
 //      and a second iteration pulls the ends together again.

@@ -22,7 +22,7 @@ namespace clothlab {
 //   x_i += w_i delta_lambda n,   x_j -= w_j delta_lambda n;   return delta_lambda
 // Hints:
 //   1. Return 0 and move nothing first for what cannot move: w_i + w_j = 0 (both ends pinned;
-//      with alpha_tilde = 0 the division would be 0 / 0) and l = 0 (no direction n).
+//      with alpha_tilde = 0 the division would be -C / 0) and l = 0 (no direction n).
 //   2. The term -alpha_tilde lambda is what makes XPBD's stiffness independent of the
 //      iterations: lambda is what this constraint has already pushed in this step. Leave it out
 //      and a second iteration pulls the ends together again.
@@ -32,7 +32,7 @@ double xpbd_distance_projection(Vec3& x_i, Vec3& x_j, double w_i, double w_j, do
                                 double alpha_tilde, double lambda) {
   // BEGIN ex12.1: see lessons/12-xpbd/README.md
   const double w = w_i + w_j;
-  if (w == 0.0) return 0.0;  // both pinned: nothing can move (and 0 / 0 with alpha_tilde = 0)
+  if (w == 0.0) return 0.0;  // both pinned: nothing can move (and -C / 0 with alpha_tilde = 0)
   const Vec3 d = x_i - x_j;
   const double l = d.norm();  // [m]
   if (l == 0.0) return 0.0;   // coincident ends: no direction to push along

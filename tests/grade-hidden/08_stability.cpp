@@ -25,9 +25,17 @@ TEST_SUITE("ex08") {
                   << " s; all of k, m and c times 7 must give the same, got " << heavier
                   << " s; k / 9 and c / 3 (time 3 times slower) must give 3 times as much, got "
                   << slower << " s");
+      CHECK(dt > 0.0);
       CHECK(std::abs(heavier - dt) <= 1e-12 * dt);
       CHECK(std::abs(slower - 3.0 * dt) <= 1e-12 * dt);
     }
+    // The last of them by hand: 0.5 lambda^2 + 12 lambda + 50 = 0 has the roots
+    // lambda = -12 +- sqrt(144 - 100) (overdamped); the faster one, -(12 + sqrt(44)) 1/s,
+    // reaches R = -1 at dt = 2 / (12 + sqrt(44)) = 0.10734 s.
+    const double overdamped = largest_stable_dt_explicit_euler(50.0, 0.5, 12.0);
+    INFO("k = 50 N/m, m = 0.5 kg, c = 12 N s/m: expected 2 / (12 + sqrt(44)) = 0.10734 s, got "
+         << overdamped << " s");
+    CHECK(std::abs(overdamped - 2.0 / (12.0 + std::sqrt(44.0))) <= 1e-12);
   }
 
   TEST_CASE("ex08.1 hidden: no jump at critical damping" * POINTS_VISIBILITY(1, hidden)) {

@@ -92,12 +92,18 @@ TEST_SUITE("ex01") {
 
   TEST_CASE("ex01.2 equal and opposite and finite for coincident bodies" * POINTS(1)) {
     // Newton's third law: the force on 2 due to 1 is minus the force on 1 due to 2.
+    // b - a = d = (1, -1.5, 3), |d| = 3.5 (half of (2, -3, 6)), G m1 m2 = 0.5 * 2 * 7 = 7:
+    // |F| = 7 / 3.5^2 = 4/7 N along d / 3.5, so f12 = (8/49) d = (8, -12, 24) / 49 N.
     {
-      const Vec3 a(0.3, -1.2, 2.0), b(-0.7, 0.4, 1.1);
+      const Vec3 a(0.3, -1.2, 2.0), b(1.3, -2.7, 5.0);
       const Vec3 f12 = clothlab::gravitation_force(a, 2.0, b, 7.0, 0.5);
       const Vec3 f21 = clothlab::gravitation_force(b, 7.0, a, 2.0, 0.5);
       INFO("gravitation_force(r1, m1, r2, m2) must equal -gravitation_force(r2, m2, r1, m1)");
       CHECK_NEAR_VEC(f12 + f21, Vec3::Zero(), 1e-12);
+      INFO(
+          "bodies of 2 and 7 kg 3.5 m apart with G = 0.5 pull with 7 / 3.5^2 = 4/7 N, along "
+          "r2 - r1");
+      CHECK_NEAR_VEC(f12, Vec3(8.0, -12.0, 24.0) / 49.0, 1e-12);
     }
     // Two bodies at the same point: there is no direction to pull along, and 1 / 0 would make a
     // NaN that spreads through the whole simulation. The lesson asks for a zero force.
@@ -124,14 +130,15 @@ TEST_SUITE("ex01") {
   }
 
   TEST_CASE("ex01.3 a particle at rest does not move in its first explicit step" * POINTS(1)) {
-    // v = 0: explicit Euler moves r by v dt = 0, even though a force acts; only v changes.
+    // v = 0: explicit Euler moves r by v dt = 0, even though a force acts; only v changes, by
+    // (f / m) dt = (0, -9.8, 0) * 2.5 * 0.01 = (0, -0.245, 0) for m = 0.4 kg (1/m = 2.5).
     const auto s =
-        clothlab::explicit_euler_step(Vec3(0, 5, 0), Vec3::Zero(), Vec3(0, -9.8, 0), 1.0, 0.01);
+        clothlab::explicit_euler_step(Vec3(0, 5, 0), Vec3::Zero(), Vec3(0, -9.8, 0), 2.5, 0.01);
     INFO(
         "if r changed here you moved the particle with the NEW velocity: that is exercise 1.4's "
         "symplectic Euler, not explicit Euler");
     CHECK_NEAR_VEC(s.r, Vec3(0, 5, 0), 0.0);
-    CHECK_NEAR_VEC(s.v, Vec3(0, -0.098, 0), 1e-12);
+    CHECK_NEAR_VEC(s.v, Vec3(0, -0.245, 0), 1e-12);
   }
 
   TEST_CASE("ex01.3 a pinned particle (inverse mass 0) is not accelerated" * POINTS(1)) {
@@ -177,26 +184,39 @@ TEST_SUITE("ex01") {
   }
 
   TEST_CASE("ex01.4 a spring's energy stays bounded over 100 periods" * POINTS(2)) {
-    // A 1 kg mass on a spring k = (2 pi)^2 N/m (period 1 s), started at x = 1 m, at rest; the
-    // force -k x is fed back every step. dt = 0.01 s, so h w = 2 pi * 0.01 = 0.063.
-    // Symplectic Euler keeps a nearby "modified" energy exactly, so E = (v^2 + k x^2) / 2 only
-    // wobbles, by about h w = 6 % at most, for ever. Explicit Euler multiplies E by
-    // 1 + (h w)^2 every step: after 10^4 steps E grows by e^(0.0395 * 10^4), far beyond 10 %.
-    const double k = 4.0 * std::numbers::pi * std::numbers::pi;
+    // A 0.5 kg mass (1/m = 2) on a spring k = 2 pi^2 N/m (w = sqrt(k / m) = 2 pi: period 1 s),
+    // started at x = 1 m, at rest; the force -k x is fed back every step. dt = 0.01 s, so
+    // h w = 2 pi * 0.01 = 0.063. Symplectic Euler keeps a nearby "modified" energy exactly, so
+    // E = (m v^2 + k x^2) / 2 only wobbles, by about h w = 6 % at most, for ever. Explicit Euler
+    // multiplies E by 1 + (h w)^2 every step: after 10^4 steps E grows by e^(0.0395 * 10^4), far
+    // beyond 10 %. Half a period in (50 steps) the mass is at the far side, x = -1 m to within
+    // the wobble (0.1 m here); a mass that never moves is not, nor one whose acceleration is
+    // f / inv_m (then w = pi, and half a second is a quarter period: x near 0).
+    const double k = 2.0 * std::numbers::pi * std::numbers::pi, m = 0.5;
     Vec3 r(1, 0, 0), v = Vec3::Zero();
     const double e0 = 0.5 * k;
     double worst = 0.0;
+    bool finite = true;
+    Vec3 half_period = Vec3::Zero();
     for (int step = 0; step < 10000; ++step) {
-      const auto s = clothlab::symplectic_euler_step(r, v, -k * r, 1.0, 0.01);
+      const auto s = clothlab::symplectic_euler_step(r, v, -k * r, 1.0 / m, 0.01);
       r = s.r;
       v = s.v;
-      const double e = 0.5 * v.squaredNorm() + 0.5 * k * r.squaredNorm();
+      const double e = 0.5 * m * v.squaredNorm() + 0.5 * k * r.squaredNorm();
+      finite = finite && std::isfinite(e);
       worst = std::max(worst, std::abs(e / e0 - 1.0));
+      if (step == 49) half_period = r;
     }
     INFO(
         "the energy of an undamped spring must stay within 10 % of its start over 10^4 steps; "
         "growing energy is the mark of explicit Euler (position moved with the old velocity)");
+    CHECK(finite);
     CHECK(worst < 0.10);
+    INFO(
+        "after half a period (50 steps of 0.01 s, period 1 s) the mass must be at the far side "
+        "of the spring, near x = -1 m; it is at "
+        << grading::show(half_period) << ": check a = f * inv_m");
+    CHECK_NEAR_VEC(half_period, Vec3(-1.0, 0.0, 0.0), 0.1);
   }
 
 }  // TEST_SUITE("ex01")

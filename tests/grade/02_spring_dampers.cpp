@@ -145,6 +145,8 @@ TEST_SUITE("ex02") {
       const Vec3 f2 = clothlab::spring_damper_force(s.r2, s.r1, s.v2, s.v1, s.ks, s.kd, s.l0);
       const Vec3 e = (s.r2 - s.r1).normalized();
       const double tol = 1e-9 * (1.0 + f1.norm());
+      // And its size along e: f_sd = -ks (l0 - l) - kd e . (v1 - v2).
+      const double f_sd = -s.ks * (s.l0 - (s.r2 - s.r1).norm()) - s.kd * e.dot(s.v1 - s.v2);
       {
         INFO(
             "calling spring_damper_force with the particles swapped must give minus the force: "
@@ -156,6 +158,11 @@ TEST_SUITE("ex02") {
             "the force must lie along the spring, f1 = f_sd e: components across e usually come "
             "from a damper that uses the whole velocities instead of e . v1 and e . v2");
         CHECK_NEAR_VEC(f1.cross(e), Vec3::Zero(), tol);
+      }
+      {
+        INFO("along e the force must be f_sd = -ks (l0 - l) - kd (e . v1 - e . v2) = " << f_sd
+                                                                                       << " N");
+        CHECK(f1.dot(e) == doctest::Approx(f_sd).epsilon(1e-9));
       }
     }
   }
@@ -222,6 +229,14 @@ TEST_SUITE("ex02") {
         "by l = 0");
     CHECK(f1.allFinite());
     CHECK_NEAR_VEC(f1, Vec3::Zero(), 0.0);
+    // Only l == 0 is special: 1 mm apart along z, e = (0, 0, 1), the spring is 0.099 m short,
+    // f_sd = -100 (0.1 - 0.001) - 2 (3 - 1) = -9.9 - 4 = -13.9 N, f1 = (0, 0, -13.9) N.
+    const Vec3 near = clothlab::spring_damper_force(
+        r, r + Vec3(0.0, 0.0, 0.001), Vec3(1.0, 2.0, 3.0), Vec3(-3.0, 0.0, 1.0), 100.0, 2.0, 0.1);
+    INFO(
+        "particles 1 mm apart are not coincident: the squeezed spring and the damper push with "
+        "f_sd = -9.9 - 4 = -13.9 N along e = (0, 0, 1)");
+    CHECK_NEAR_VEC(near, Vec3(0.0, 0.0, -13.9), 1e-9);
   }
 
   // --- Exercise ex02.2: the energy of a spring ---------------------------------------------------

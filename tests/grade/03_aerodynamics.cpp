@@ -190,6 +190,14 @@ TEST_SUITE("ex03") {
           "air blowing along the surface sees no area (a = a0 (v . n) / |v| = 0) and must not "
           "push: a force here means the full area a0 was used, or the force was put along v");
       CHECK_NEAR_VEC(f, Vec3::Zero(), 1e-12);
+      // Tilt that wind out of the plane, v_air = (4, 0, -3): v = (-4, 0, 3), |v| = 5,
+      // v . n = 3, a = 0.5 * 3 / 5 = 0.3 m^2, f = -1/2 * 1.2 * 25 * 1 * 0.3 n = (0, 0, -4.5) N.
+      const Vec3 tilted = clothlab::aerodynamic_force(r1, r2, r3, Vec3::Zero(), Vec3::Zero(),
+                                                      Vec3::Zero(), Vec3(4.0, 0.0, -3.0), 1.2, 1.0);
+      INFO(
+          "a wind of (4, 0, -3) m/s meets the same triangle at v . n / |v| = 0.6 and pushes with "
+          "1/2 rho |v|^2 cd a = 4.5 N along -n");
+      CHECK_NEAR_VEC(tilted, Vec3(0.0, 0.0, -4.5), 1e-9);
     }
     {
       // No relative wind: the corners move with the air, v = 0, and a = a0 (v . n) / |v| is
@@ -329,6 +337,11 @@ TEST_SUITE("ex03") {
         "Vec3::Zero() when |u| == 0, instead of dividing by |u|");
     CHECK(f.allFinite());
     CHECK_NEAR_VEC(f, Vec3::Zero(), 0.0);
+    // A slow relative motion is not zero: u = (0, 0.3, -0.4), |u| = 0.5 m/s,
+    // f = -1/2 * 1.2 * 0.5 * 0.1 * |u| u = -0.015 u = (0, -0.0045, 0.006) N.
+    const Vec3 slow = clothlab::fluid_drag_force(w + Vec3(0.0, 0.3, -0.4), w, 1.2, 0.5, 0.1);
+    INFO("0.5 m/s through the fluid gives 1/2 rho |u|^2 cd a = 7.5 mN against u");
+    CHECK_NEAR_VEC(slow, Vec3(0.0, -0.0045, 0.006), 1e-12);
   }
 
 }  // TEST_SUITE("ex03")

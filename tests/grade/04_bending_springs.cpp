@@ -154,6 +154,13 @@ TEST_SUITE("ex04") {
         CHECK_MESSAGE(not_two_apart.empty(),
                       "not two apart on a row or a column: " << show(not_two_apart));
       }
+      {
+        // And there are rows (cols - 2) + cols (rows - 2) of them: 22, 18, 22 and 6 pairs.
+        const size_t count = static_cast<size_t>(g.rows * (g.cols - 2) + g.cols * (g.rows - 2));
+        INFO("a " << g.rows << " x " << g.cols << " grid has " << count << " bending pairs; got "
+                  << got.size());
+        CHECK(got.size() == count);
+      }
     }
   }
 

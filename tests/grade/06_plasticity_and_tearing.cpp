@@ -91,6 +91,16 @@ TEST_SUITE("ex06") {
       CHECK(at_yield_stretched == l0);
       CHECK(at_yield_compressed == l0);
     }
+    {
+      // Just past the yield, l = 2.52: strain 0.26 > 0.25, so it flows, the whole way here:
+      // l0' = 2.52 / 1.25 = 2.016.
+      const double past_yield = clothlab::plastic_rest_length(2.52, l0, l0, limits, 1.0);
+      INFO(
+          "just past the yield strain (l = 2.52, strain 0.26) the spring is plastic and takes "
+          "the rest length 2.52 / 1.25 = 2.016; got "
+          << past_yield);
+      CHECK(past_yield == doctest::Approx(2.016).epsilon(1e-12));
+    }
   }
 
   TEST_CASE("ex06.1 past yield a full flow jumps to the yield target" * POINTS(1)) {
@@ -173,6 +183,15 @@ TEST_SUITE("ex06") {
     // |l - l0'| <= |l - l0|: the spring's energy ks (l - l0)^2 / 2 can only go down. With
     // l_built chosen so that l0 is within l_built (1 +- max_strain), the clamp keeps this.
     // Every result must also be positive and finite.
+    // One of them by hand: l0 = l_built = 2, l = 1.7 * 2 = 3.4, yield_strain = 0.2, flow_rate
+    // = 30 1/s, dt = 0.02 s: target 3.4 / 1.2 = 17/6, fraction 0.6, l0' = 2 + 0.6 (17/6 - 2) =
+    // 2.5, within the clamp [0.2, 3.8].
+    {
+      const double r = clothlab::plastic_rest_length(3.4, 2.0, 2.0, {0.2, 30.0, 0.9}, 0.02);
+      INFO("l = 3.4, l0 = l_built = 2, yield_strain = 0.2, flow_rate dt = 0.6: l0' = 2.5; got "
+           << r);
+      CHECK(r == doctest::Approx(2.5).epsilon(1e-12));
+    }
     const std::array<double, 3> rest = {0.5, 1.0, 2.0};
     const std::array<double, 10> ratios = {0.3, 0.6, 0.85, 0.95, 1.0, 1.04, 1.2, 1.7, 3.0, 5.0};
     const std::array<double, 3> builts = {1.0, 0.8, 1.25};  // l0 / l_built

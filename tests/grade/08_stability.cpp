@@ -57,6 +57,14 @@ TEST_SUITE("ex08") {
         "the answer is 0 (unstable at every dt); got "
         << a << " s");
     CHECK(a == 0.0);
+    // The smallest damper opens a window: k = 100 N/m, m = 0.3 kg, c = 0.5 N s/m, c^2 = 0.25
+    // < 4 k m = 120 (underdamped), stable up to c / k = 0.005 s.
+    const double b = largest_stable_dt_explicit_euler(100.0, 0.3, 0.5);
+    INFO(
+        "k = 100 N/m, m = 0.3 kg and a small damper c = 0.5 N s/m: stable up to c / k = "
+        "0.005 s; got "
+        << b << " s");
+    CHECK(close(b, 0.005));
   }
 
   TEST_CASE("ex08.1 an overdamped spring is limited by its faster root" * POINTS(2)) {

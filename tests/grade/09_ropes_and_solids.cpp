@@ -63,6 +63,19 @@ TEST_SUITE("ex09") {
       CHECK(c.dr1 == Vec3::Zero());
       CHECK(c.dr2 == Vec3::Zero());
     }
+    {
+      // Past the limit it is corrected: l = 5.5 along y, C = 5.5 - 5 = 0.5, e = (0, 1, 0), and
+      // with w1 = 1.5, w2 = 0.5 the shares are 3/4 and 1/4: dr1 = (0, 0.375, 0),
+      // dr2 = (0, -0.125, 0).
+      const StrainCorrection c = clothlab::strain_limit_correction(r1, r1 + Vec3(0.0, 5.5, 0.0),
+                                                                   1.5, 0.5, 4.0, stretch_only);
+      INFO(
+          "a spring 5.5 long, past its limit 5, must be pulled back to it: dr1 = (0, 0.375, 0), "
+          "dr2 = (0, -0.125, 0); got dr1 = "
+          << grading::show(c.dr1) << ", dr2 = " << grading::show(c.dr2));
+      CHECK_NEAR_VEC(c.dr1, Vec3(0.0, 0.375, 0.0), 1e-12);
+      CHECK_NEAR_VEC(c.dr2, Vec3(0.0, -0.125, 0.0), 1e-12);
+    }
   }
 
   TEST_CASE("ex09.1 a stretched spring between equal masses worked by hand" * POINTS(2)) {
@@ -193,6 +206,15 @@ TEST_SUITE("ex09") {
     CHECK(finite(c.dr2));
     CHECK(c.dr1 == Vec3::Zero());
     CHECK(c.dr2 == Vec3::Zero());
+    // Only l == 0 is special: 1 mm apart along e = (0.6, 0, 0.8) the spring is past its limit
+    // 2, C = 0.001 - 2 = -1.999, and w1 = 1, w2 = 3 give dr1 = 1/4 C e = -0.49975 e =
+    // (-0.29985, 0, -0.3998), dr2 = -3/4 C e = 1.49925 e = (0.89955, 0, 1.1994).
+    const StrainCorrection near = clothlab::strain_limit_correction(
+        r, r + 0.001 * Vec3(0.6, 0.0, 0.8), 1.0, 3.0, 4.0, StrainLimits{0.1, 0.5});
+    INFO("ends 1 mm apart are pushed apart to the compression limit 2; got dr1 = "
+         << grading::show(near.dr1) << ", dr2 = " << grading::show(near.dr2));
+    CHECK_NEAR_VEC(near.dr1, Vec3(-0.29985, 0.0, -0.3998), 1e-10);
+    CHECK_NEAR_VEC(near.dr2, Vec3(0.89955, 0.0, 1.1994), 1e-10);
   }
 
   TEST_CASE("ex09.1 one correction lands on the limit along the spring for any spring" *

@@ -172,9 +172,21 @@ TEST_SUITE("ex10") {
     const PairState touching{Vec3::Zero(), Vec3::Zero(), Vec3(0.036, 0.048, 0.0),
                              Vec3(0.0, -1.0, 0.0)};
     const PairState t = clothlab::pair_response(touching, 1.0, 1.0, kContact);
-    INFO("a pair exactly the thickness apart (d = 0.06) is not overlapping; got " << show(t));
-    CHECK((t.r1 - touching.r1).norm() <= 1e-12);
-    CHECK((t.r2 - touching.r2).norm() <= 1e-12);
+    {
+      INFO("a pair exactly the thickness apart (d = 0.06) is not overlapping; got " << show(t));
+      CHECK((t.r1 - touching.r1).norm() <= 1e-12);
+      CHECK((t.r2 - touching.r2).norm() <= 1e-12);
+    }
+    // The far pair brought to d = 0.05 (r2 = r1 + (0.03, 0.04, 0), n = (0.6, 0.8, 0)) does
+    // overlap: C = 0.01, and w1 = 1.5, w2 = 0.5 give shares 3/4 and 1/4:
+    //   r1' = r1 - 0.0075 n = (0.9955, 1.994, 3),   r2' = r2 + 0.0025 n = (1.0315, 2.042, 3).
+    PairState closer = far;
+    closer.r2 = Vec3(1.03, 2.04, 3.0);
+    const PairState c = clothlab::pair_response(closer, 1.5, 0.5, kContact);
+    INFO("the same pair 0.05 apart overlaps by 0.01 and is pushed apart, 3/4 and 1/4; got "
+         << show(c));
+    CHECK_NEAR_VEC(c.r1, Vec3(0.9955, 1.994, 3.0), 1e-12);
+    CHECK_NEAR_VEC(c.r2, Vec3(1.0315, 2.042, 3.0), 1e-12);
   }
 
   TEST_CASE("ex10.2 an overlapping pair is pushed apart to the thickness worked by hand" *
@@ -254,11 +266,25 @@ TEST_SUITE("ex10") {
     const PairState same_point{Vec3(0.2, 0.1, 0.0), Vec3(1.0, 0.0, 0.0), Vec3(0.2, 0.1, 0.0),
                                Vec3(0.0, 1.0, 0.0)};
     const PairState s = clothlab::pair_response(same_point, 1.0, 1.0, kContact);
+    {
+      INFO(
+          "two particles at the same point give no direction n = d* / |d*| to push along: "
+          "return the pair unchanged before dividing by d = 0 (hint 1); got "
+          << show(s));
+      CHECK(unchanged(s, same_point));
+    }
+    // Only d == 0 is special: 0.01 m apart along n = (0, 0, 1), C = 0.05, and w1 = 1, w2 = 4
+    // give shares 1/5 and 4/5: r1' = r1 - 0.01 n = (0.2, 0.1, -0.01), r2' = r2 + 0.04 n =
+    // (0.2, 0.1, 0.05).
+    PairState apart = same_point;
+    apart.r2.z() = 0.01;
+    const PairState a = clothlab::pair_response(apart, 1.0, 4.0, kContact);
     INFO(
-        "two particles at the same point give no direction n = d* / |d*| to push along: return "
-        "the pair unchanged before dividing by d = 0 (hint 1); got "
-        << show(s));
-    CHECK(unchanged(s, same_point));
+        "particles 0.01 m apart are not at the same point: pushed apart to 0.06, 1/5 and 4/5; "
+        "got "
+        << show(a));
+    CHECK_NEAR_VEC(a.r1, Vec3(0.2, 0.1, -0.01), 1e-12);
+    CHECK_NEAR_VEC(a.r2, Vec3(0.2, 0.1, 0.05), 1e-12);
   }
 
   TEST_CASE("ex10.2 an approaching pair loses its approach speed" * POINTS(1)) {
@@ -333,6 +359,41 @@ TEST_SUITE("ex10") {
         << show(f));
     CHECK_NEAR_VEC(f.v1, Vec3(0.1, -0.5, 0.0), 1e-12);
     CHECK_NEAR_VEC(f.v2, Vec3(1.9, -0.5, 0.0), 1e-12);
+    // The cases above have j = 1 m/s and equal masses, where mu_d j and mu_d / j, or a share and
+    // its half, agree. Here they do not: e = 0.5, w1 = 3, w2 = 1 (shares 3/4 and 1/4), and
+    // u . n = -2 m/s, so j = (1 + 0.5) * 2 = 3 m/s, mu_s j = 0.9 m/s and mu_d j = 0.6 m/s.
+    {
+      SelfContact bouncy = kContact;
+      bouncy.e = 0.5;
+      // Dynamic: v2 = (3, -2, 0), u_t = (3, 0, 0), |u_t| = 3 > 0.9, friction takes 0.6 m/s:
+      // du = 1.5 * 2 n - 0.6 (1, 0, 0) = (-0.6, 3, 0), v1' = -3/4 du = (0.45, -2.25, 0),
+      // v2' = v2 + 1/4 du = (2.85, -1.25, 0): they part at 1 m/s = e * 2 and slide at 2.4 m/s.
+      const PairState sliding{Vec3::Zero(), Vec3::Zero(), Vec3(0.0, 0.05, 0.0),
+                              Vec3(3.0, -2.0, 0.0)};
+      const PairState d = clothlab::pair_response(sliding, 3.0, 1.0, bouncy);
+      {
+        INFO(
+            "e = 0.5, w1 = 3, w2 = 1, approaching at 2 m/s and sliding at 3 m/s: j = 3 m/s, "
+            "dynamic friction takes mu_d j = 0.6 m/s (not mu_d / j), shared 3/4 and 1/4: "
+            "v1' = (0.45, -2.25, 0), v2' = (2.85, -1.25, 0) (hint 4); got "
+            << show(d));
+        CHECK_NEAR_VEC(d.v1, Vec3(0.45, -2.25, 0.0), 1e-12);
+        CHECK_NEAR_VEC(d.v2, Vec3(2.85, -1.25, 0.0), 1e-12);
+      }
+      // Static: v2 = (0.6, -2, 0), |u_t| = 0.6 <= mu_s j = 0.9 (though > mu_s = 0.3): it sticks,
+      // du = (0, 3, 0) - (0.6, 0, 0) = (-0.6, 3, 0) again, v1' = (0.45, -2.25, 0),
+      // v2' = (0.45, -1.25, 0): no sliding left, parting at 1 m/s.
+      const PairState sticking{Vec3::Zero(), Vec3::Zero(), Vec3(0.0, 0.05, 0.0),
+                               Vec3(0.6, -2.0, 0.0)};
+      const PairState t = clothlab::pair_response(sticking, 3.0, 1.0, bouncy);
+      INFO(
+          "sliding at 0.6 m/s with j = 3 m/s and mu_s = 0.3: |u_t| <= mu_s j = 0.9, so static "
+          "friction stops the sliding (compare with mu_s j, not mu_s): v1' = (0.45, -2.25, 0), "
+          "v2' = (0.45, -1.25, 0); got "
+          << show(t));
+      CHECK_NEAR_VEC(t.v1, Vec3(0.45, -2.25, 0.0), 1e-12);
+      CHECK_NEAR_VEC(t.v2, Vec3(0.45, -1.25, 0.0), 1e-12);
+    }
   }
 
   TEST_CASE("ex10.2 momentum and the centre of mass are kept for any pair" * POINTS(1)) {

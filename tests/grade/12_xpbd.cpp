@@ -8,6 +8,7 @@
 // The numbers are chosen so that every value comes out as a short fraction: d = (0, -3, -4) has
 // l = 5 and n = (0, -0.6, -0.8).
 #include <cmath>
+#include <string>
 
 #include "clothlab/integrators/xpbd.hpp"
 #include "grading.hpp"
@@ -42,6 +43,15 @@ TEST_SUITE("ex12") {
     CHECK(std::abs(p.dl) <= 1e-12);
     CHECK((p.x_i - x_i).norm() <= 1e-12);
     CHECK((p.x_j - x_j).norm() <= 1e-12);
+    // With l0 = 4.5 the same pair is 0.5 too long: n = (x_i - x_j) / l = (0, -0.6, -0.8),
+    // delta_lambda = -0.5 / (1 + 2 + 0.5) = -1/7; x_i += 1 (-1/7) n = (0, 0.6, 0.8) / 7,
+    // x_j -= 2 (-1/7) n, that is by (0, -1.2, -1.6) / 7.
+    const Projected q = project(x_i, x_j, 1.0, 2.0, 4.5, 0.5, 0.0);
+    INFO("the same pair with l0 = 4.5 is stretched by 0.5: delta_lambda = -0.5 / 3.5 = -1/7; got "
+         << q.dl << ", x_i = " << grading::show(q.x_i) << ", x_j = " << grading::show(q.x_j));
+    CHECK(q.dl == doctest::Approx(-1.0 / 7.0).epsilon(1e-12));
+    CHECK_NEAR_VEC(q.x_i, Vec3(x_i + Vec3(0.0, 0.6, 0.8) / 7.0), 1e-12);
+    CHECK_NEAR_VEC(q.x_j, Vec3(x_j + Vec3(0.0, -1.2, -1.6) / 7.0), 1e-12);
   }
 
   TEST_CASE("ex12.1 a stretched and a squeezed pair of equal masses worked by hand" * POINTS(2)) {
@@ -96,7 +106,7 @@ TEST_SUITE("ex12") {
     CHECK(momentum.norm() <= 1e-12);
   }
 
-  TEST_CASE("ex12.1 a pinned end never moves" * POINTS(1)) {
+  TEST_CASE("ex12.1 a pinned end never moves and coincident ends move nothing" * POINTS(1)) {
     {
       // x_i = 0 pinned (w_i = 0), x_j = (0, -1.5, 0), l0 = 1: n = (0, 1, 0), C = 0.5,
       // delta_lambda = -0.5 / (0 + 1) = -0.5; x_j -= 1 (-0.5) (0, 1, 0), to (0, -1, 0).
@@ -110,7 +120,8 @@ TEST_SUITE("ex12") {
       CHECK(p.dl == doctest::Approx(-0.5).epsilon(1e-12));
     }
     {
-      // Both pinned and rigid: w_i + w_j + alpha_tilde = 0, and delta_lambda would be 0 / 0.
+      // Both pinned and rigid: w_i + w_j + alpha_tilde = 0, and delta_lambda would be
+      // -C / 0 = -0.5 / 0 = -infinity (0 / 0, NaN, for a pair at its rest length).
       const Projected p = project(Vec3::Zero(), Vec3(0.0, -1.5, 0.0), 0.0, 0.0, 1.0, 0.0, 0.0);
       INFO(
           "both ends pinned (w_i = w_j = 0), alpha_tilde = 0: nothing can move; return 0 "
@@ -177,11 +188,20 @@ TEST_SUITE("ex12") {
     }
     const double dl2 = clothlab::xpbd_distance_projection(x_i, x_j, 1.0, 1.0, 1.0, 1.0, lambda);
     {
+      // What a wrong answer here usually is: -1/9 (and the pair pulled closer) without the term
+      // -alpha_tilde lambda; -1/3 with nothing moved, the lambda given plus a delta_lambda of 0.
+      const std::string mistake =
+          std::abs(dl2 + 1.0 / 9.0) <= 1e-9
+              ? "-1/9 means the term -alpha_tilde lambda is missing (hint 2)"
+          : std::abs(dl2 + 1.0 / 3.0) <= 1e-9
+              ? "-1/3 is the lambda given plus delta_lambda = 0: return delta_lambda alone, not "
+                "lambda + delta_lambda (hint 4)"
+              : "delta_lambda = (-C - alpha_tilde lambda) / (w_i + w_j + alpha_tilde) (hints 2 "
+                "and 4)";
       INFO(
           "iteration 2, lambda = -1/3: C = 1/3 = -alpha_tilde lambda, so delta_lambda = 0 and "
-          "the pair stays 4/3 apart; a -1/9 here means the term -alpha_tilde lambda is missing "
-          "(hint 2); got "
-          << dl2 << " and length " << (x_j - x_i).norm());
+          "the pair stays 4/3 apart; "
+          << mistake << "; got " << dl2 << " and length " << (x_j - x_i).norm());
       CHECK(std::abs(dl2) <= 1e-12);
       CHECK((x_j - x_i).norm() == doctest::Approx(4.0 / 3.0).epsilon(1e-12));
     }
@@ -197,6 +217,20 @@ TEST_SUITE("ex12") {
       CHECK(p.dl == doctest::Approx(-1.0 / 6.0).epsilon(1e-12));
       CHECK_NEAR_VEC(p.x_i, Vec3(1.0 / 6.0, 0.0, 0.0), 1e-12);
       CHECK_NEAR_VEC(p.x_j, Vec3(11.0 / 6.0, 0.0, 0.0), 1e-12);
+    }
+    {
+      // alpha_tilde = 1 above makes alpha_tilde lambda and lambda alike. With alpha_tilde = 0.5,
+      // lambda = -0.8, w_i = 2, w_j = 0.5: delta_lambda = (-1 + 0.4) / (2.5 + 0.5) = -0.2;
+      // x_i += 2 (-0.2) (-1, 0, 0) -> (0.4, 0, 0), x_j -= 0.5 (-0.2) (-1, 0, 0) -> (1.9, 0, 0).
+      const Projected p = project(Vec3::Zero(), Vec3(2.0, 0.0, 0.0), 2.0, 0.5, 1.0, 0.5, -0.8);
+      INFO(
+          "x_i = (0, 0, 0), x_j = (2, 0, 0), l0 = 1, w_i = 2, w_j = 0.5, alpha_tilde = 0.5, "
+          "lambda = -0.8: delta_lambda = (-C - alpha_tilde lambda) / (w_i + w_j + alpha_tilde) = "
+          "-0.6 / 3 = -0.2; got "
+          << p.dl);
+      CHECK(p.dl == doctest::Approx(-0.2).epsilon(1e-12));
+      CHECK_NEAR_VEC(p.x_i, Vec3(0.4, 0.0, 0.0), 1e-12);
+      CHECK_NEAR_VEC(p.x_j, Vec3(1.9, 0.0, 0.0), 1e-12);
     }
   }
 }

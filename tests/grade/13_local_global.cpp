@@ -100,6 +100,12 @@ TEST_SUITE("ex13") {
     CHECK(std::isfinite(d.y()));
     CHECK(std::isfinite(d.z()));
     CHECK(d == previous);
+    // Only l == 0 is special: 1 mm apart along e / l = (0.6, 0, 0.8) the ends give their own
+    // direction, d = 1.5 (0.6, 0, 0.8) = (0.9, 0, 1.2), whatever d_previous was.
+    const Vec3 near = project(x + 0.001 * Vec3(0.6, 0.0, 0.8), x, 1.5, previous);
+    INFO("ends 1 mm apart have a direction: d = 1.5 (0.6, 0, 0.8) = (0.9, 0, 1.2); got "
+         << grading::show(near));
+    CHECK_NEAR_VEC(near, Vec3(0.9, 0.0, 1.2), 1e-10);
   }
 
   TEST_CASE("ex13.1 d depends on x_i - x_j and l0 alone" * POINTS(1)) {

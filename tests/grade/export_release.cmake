@@ -32,10 +32,13 @@ foreach(file CMakeLists.txt CMakePresets.json README.md course.toml .clang-forma
     file(COPY ${SOURCE}/${file} DESTINATION ${tree})
   endif()
 endforeach()
+# tests/grade/planted/ holds lines of the solutions (the mistakes are planted in copies of them),
+# and its tests run only where solutions/ is.
 foreach(dir engine lessons tests)
   file(COPY ${SOURCE}/${dir} DESTINATION ${tree}
        PATTERN "__pycache__" EXCLUDE
-       PATTERN "grade-hidden" EXCLUDE)
+       PATTERN "grade-hidden" EXCLUDE
+       PATTERN "planted" EXCLUDE)
 endforeach()
 if(GRADESCOPE AND EXISTS ${SOURCE}/tests/grade-hidden)
   file(COPY ${SOURCE}/tests/grade-hidden DESTINATION ${tree}/tests)
