@@ -1,13 +1,17 @@
 // grade-confine: the last step before a submission's kernels program runs (sandbox.hpp).
 //
-//   grade-confine HOME PROGRAM [ARGS...]
+//   grade-confine [--no-writes] HOME PROGRAM [ARGS...]
 //
 // runs PROGRAM with an environment of three variables (PATH, LANG=C, HOME) and under a seccomp
 // filter that lets it start threads but no other process, and take memory only as its address
 // space (bounded by RLIMIT_AS, which it inherits): no System V shared memory, no memory files, no
-// new namespaces. So a case is one process, and its memory is bounded as a whole: its address
-// space, and the small memory-backed folders the sandbox gives it. A filter is inherited by every
-// thread and survives exec, and nothing the kernels do can lift it.
+// new namespaces; and it may not trace or reach into another process's memory. So a case is one
+// process, and its memory is bounded as a whole: its address space, and the small memory-backed
+// folders the sandbox gives it. With --no-writes (where there is no sandbox), it may also create,
+// change or remove no file and open no socket: the machine's own /tmp is no place to hold gigabytes
+// in, nor the grader's folders a place to plant links. A filter is inherited by every thread and
+// survives exec, and nothing the kernels do can lift it.
+#include <fcntl.h>
 #include <linux/audit.h>
 #include <linux/filter.h>
 #include <linux/seccomp.h>
@@ -21,6 +25,7 @@
 #include <cstddef>
 #include <cstdio>
 #include <string>
+#include <vector>
 
 namespace {
 
@@ -51,9 +56,21 @@ constexpr unsigned kNoSuchCall = SECCOMP_RET_ERRNO | ENOSYS;
 #define CLOTHLAB_DENY(nr, ret) \
   jump(BPF_JMP | BPF_JEQ | BPF_K, (nr), 0, 1), statement(BPF_RET | BPF_K, (ret))
 
-bool load_filter() {
+// The calls that make, change or remove a file, a folder or a link, and sockets: refused with
+// --no-writes. (open and openat are refused only when their flags ask to write or create.)
+constexpr long kWriteCalls[] = {
+#if defined(__x86_64__)
+    SYS_creat,      SYS_mkdir,    SYS_rmdir,     SYS_unlink,   SYS_rename,    SYS_link,
+    SYS_symlink,    SYS_truncate, SYS_mknod,     SYS_chmod,    SYS_chown,     SYS_lchown,
+#endif
+    SYS_mkdirat,    SYS_unlinkat, SYS_renameat2, SYS_linkat,   SYS_symlinkat, SYS_mknodat,
+    SYS_fchmodat,   SYS_fchownat, SYS_utimensat, SYS_setxattr, SYS_lsetxattr, SYS_socket,
+    SYS_socketpair,
+};
+
+bool load_filter(bool no_writes) {
   constexpr unsigned kArgLow = offsetof(seccomp_data, args[0]);  // little-endian: the low word
-  sock_filter filter[] = {
+  std::vector<sock_filter> filter = {
     // Another architecture's calls (x86-64's i386 entry) have other numbers: refused whole.
     statement(BPF_LD | BPF_W | BPF_ABS, offsetof(seccomp_data, arch)),
     jump(BPF_JMP | BPF_JEQ | BPF_K, kArch, 1, 0),
@@ -63,24 +80,48 @@ bool load_filter() {
     // x32's calls are x86-64's numbers with bit 30 set.
     jump(BPF_JMP | BPF_JGE | BPF_K, 0x40000000U, 0, 1),
     statement(BPF_RET | BPF_K, kDeny),
-    CLOTHLAB_DENY(SYS_fork, kDeny),
-    CLOTHLAB_DENY(SYS_vfork, kDeny),
 #endif
-    CLOTHLAB_DENY(SYS_clone3, kNoSuchCall),
-    CLOTHLAB_DENY(SYS_shmget, kDeny),
-    CLOTHLAB_DENY(SYS_memfd_create, kDeny),
-    CLOTHLAB_DENY(SYS_io_uring_setup, kDeny),
-    CLOTHLAB_DENY(SYS_unshare, kDeny),
-    CLOTHLAB_DENY(SYS_setns, kDeny),
-    // clone makes a thread when its flags hold CLONE_THREAD, a process otherwise.
-    jump(BPF_JMP | BPF_JEQ | BPF_K, SYS_clone, 1, 0),
-    statement(BPF_RET | BPF_K, SECCOMP_RET_ALLOW),
-    statement(BPF_LD | BPF_W | BPF_ABS, kArgLow),
-    jump(BPF_JMP | BPF_JSET | BPF_K, CLONE_THREAD, 0, 1),
-    statement(BPF_RET | BPF_K, SECCOMP_RET_ALLOW),
-    statement(BPF_RET | BPF_K, kDeny),
   };
-  const sock_fprog program{static_cast<unsigned short>(sizeof filter / sizeof filter[0]), filter};
+  const auto deny = [&](long nr, unsigned ret) {
+    filter.push_back(jump(BPF_JMP | BPF_JEQ | BPF_K, static_cast<unsigned>(nr), 0, 1));
+    filter.push_back(statement(BPF_RET | BPF_K, ret));
+  };
+  // A call whose argument `arg` has any of `bits` set is refused.
+  const auto deny_flags = [&](long nr, int arg, unsigned bits) {
+    filter.push_back(jump(BPF_JMP | BPF_JEQ | BPF_K, static_cast<unsigned>(nr), 0, 4));
+    filter.push_back(statement(BPF_LD | BPF_W | BPF_ABS,
+                               static_cast<unsigned>(offsetof(seccomp_data, args[0]) + 8 * arg)));
+    filter.push_back(jump(BPF_JMP | BPF_JSET | BPF_K, bits, 0, 1));
+    filter.push_back(statement(BPF_RET | BPF_K, kDeny));
+    filter.push_back(statement(BPF_RET | BPF_K, SECCOMP_RET_ALLOW));
+  };
+#if defined(__x86_64__)
+  deny(SYS_fork, kDeny);
+  deny(SYS_vfork, kDeny);
+#endif
+  deny(SYS_clone3, kNoSuchCall);
+  // Nor may they reach into another process (the grading binary, another case) by its memory.
+  for (const long nr : {SYS_shmget, SYS_memfd_create, SYS_io_uring_setup, SYS_unshare, SYS_setns,
+                        SYS_ptrace, SYS_process_vm_readv, SYS_process_vm_writev})
+    deny(nr, kDeny);
+  if (no_writes) {
+    for (const long nr : kWriteCalls)
+      deny(nr, kDeny);
+    deny(SYS_openat2, kNoSuchCall);  // its flags are in memory: the C library falls back to openat
+    constexpr unsigned kWriting = O_WRONLY | O_RDWR | O_CREAT | O_TRUNC;
+#if defined(__x86_64__)
+    deny_flags(SYS_open, 1, kWriting);
+#endif
+    deny_flags(SYS_openat, 2, kWriting);
+  }
+  // clone makes a thread when its flags hold CLONE_THREAD, a process otherwise.
+  filter.push_back(jump(BPF_JMP | BPF_JEQ | BPF_K, SYS_clone, 1, 0));
+  filter.push_back(statement(BPF_RET | BPF_K, SECCOMP_RET_ALLOW));
+  filter.push_back(statement(BPF_LD | BPF_W | BPF_ABS, kArgLow));
+  filter.push_back(jump(BPF_JMP | BPF_JSET | BPF_K, CLONE_THREAD, 0, 1));
+  filter.push_back(statement(BPF_RET | BPF_K, SECCOMP_RET_ALLOW));
+  filter.push_back(statement(BPF_RET | BPF_K, kDeny));
+  const sock_fprog program{static_cast<unsigned short>(filter.size()), filter.data()};
   return prctl(PR_SET_NO_NEW_PRIVS, 1, 0, 0, 0) == 0 &&
          prctl(PR_SET_SECCOMP, SECCOMP_MODE_FILTER, &program) == 0;
 }
@@ -88,13 +129,18 @@ bool load_filter() {
 }  // namespace
 
 int main(int argc, char** argv) {
+  const bool no_writes = argc > 1 && std::string(argv[1]) == "--no-writes";
+  if (no_writes) {
+    --argc;
+    ++argv;
+  }
   if (argc < 3) {
-    std::fputs("usage: grade-confine HOME PROGRAM [ARGS...]\n", stderr);
+    std::fputs("usage: grade-confine [--no-writes] HOME PROGRAM [ARGS...]\n", stderr);
     return 2;
   }
   const rlimit threads{kMaxThreads, kMaxThreads};
   setrlimit(RLIMIT_NPROC, &threads);
-  if (!load_filter()) {
+  if (!load_filter(no_writes)) {
     std::perror("grade-confine: cannot load the seccomp filter that keeps a case to one process");
     return 126;
   }

@@ -59,7 +59,8 @@ std::vector<std::string> Confinement::kernels(const std::string& launcher,
     args = joined(args, {"--ro-bind", launcher, launcher, "--ro-bind", program, program, "--chdir",
                          "/tmp", "--"});
   }
-  // HOME: the sandbox's /tmp, or the machine's, which the user nobody may write in too.
+  // Without a sandbox, the machine's folders are the kernels' to write in: they may write none.
+  if (bwrap.empty()) return joined(args, {launcher, "--no-writes", "/tmp", program});
   return joined(args, {launcher, "/tmp", program});
 }
 

@@ -4,15 +4,15 @@
 // Two layers, each where the machine allows it:
 // - a user: when the grader runs as root, the submission's processes run as the user nobody
 //   (util-linux's setpriv), so they cannot write the grader's files, signal or read its
-//   processes, and the limit on processes holds for them (Linux does not hold root to it);
+//   processes, and the limit on threads holds for them (Linux does not hold root to it);
 // - a sandbox: bubblewrap gives them a new root that holds the system's programs and libraries
 //   (read-only), /dev (read-only but for a small /dev/shm), /proc, a small empty /tmp and only the
 //   files they need; no network, no other process to see, a session of their own, and every
 //   process ends with them.
 // And, in every mode, the kernels start through grade-confine (confine_main.cpp): an environment
-// of PATH, LANG=C and HOME alone, and a filter that lets them start threads but no process, so
-// that the memory of a case is bounded as a whole: its address space (RLIMIT_AS) and its two small
-// folders in memory (kTmpBytes each).
+// of PATH, LANG=C and HOME alone, and a filter that lets them start threads but no process (and,
+// without a sandbox, write no file), so that the memory of a case is bounded as a whole: its
+// address space (RLIMIT_AS) and the sandbox's two small folders in memory (kTmpBytes each).
 #pragma once
 
 #include <cstddef>

@@ -39,12 +39,13 @@ run=()
 grade() {
   local sub=$1
   shift
+  rm -f "$work/$sub.json"
   set +e
   NO_COLOR=1 "${run[@]}" "$grader" grade --submission "$work/$sub" --scratch "$work/scratch" \
     --results "$work/$sub.json" --exercise ex01 --timeout 10 "$@" >"$work/$sub.out" 2>&1
   code=$?
   set -e
-  score=$(score_of "$work/$sub.json")
+  score=$(score_of "$work/$sub.json" || true)
   echo "--- $sub: exit $code, score $score"
   cat "$work/$sub.out"
 }
@@ -77,9 +78,8 @@ static bool only_three() {
 CLOTHLAB_GRADER_SECRET=leaked grade environment
 expect_full environment "the grader's environment reached the kernels"
 
-if [[ -x /usr/bin/bwrap ]] && /usr/bin/bwrap --unshare-all --ro-bind / / /bin/true 2>/dev/null; then
-  # --- a pool of threads is honest --------------------------------------------------------------
-  patched threads '#include <thread>
+# --- a pool of threads is honest --------------------------------------------------------------
+patched threads '#include <thread>
 #include <vector>
 // Starts 300 threads, each adding one, and joins them: true when all ran.
 static bool pool_ran() {
@@ -94,13 +94,11 @@ static bool pool_ran() {
   }
   return ran == 300;
 }' 'pool_ran()'
-  grade threads --sandbox on
-  expect_full threads "a correct solution with a pool of 300 threads lost points"
 
-  # --- no child process to hold more memory -----------------------------------------------------
-  # Address space is reserved (not touched): what a case could fill. Three children and the case
-  # itself each reserve 3 GiB; together they may not reach the 4 GiB one process is allowed.
-  patched children '#include <sys/mman.h>
+# --- no child process to hold more memory -----------------------------------------------------
+# Address space is reserved (not touched): what a case could fill. Three children and the case
+# itself each reserve 3 GiB; together they may not reach the 4 GiB one process is allowed.
+patched children '#include <sys/mman.h>
 #include <unistd.h>
 // The GiB of address space this case and three children reserved at once.
 static int reserved_gib() {
@@ -122,12 +120,10 @@ static int reserved_gib() {
   for (char c; read(fds[0], &c, 1) == 1;) total += c - 0x30;
   return total;
 }' 'reserved_gib() < 4'
-  sed -i 's|for (char c; read|usleep(500000); for (char c; read|' "$work/children/$name"
-  grade children --sandbox on
-  expect_full children "a case and its children held more than one process's 4 GiB"
+sed -i 's|for (char c; read|usleep(500000); for (char c; read|' "$work/children/$name"
 
-  # --- files in memory ----------------------------------------------------------------------------
-  patched memory-files '#include <csignal>
+# --- files in memory ----------------------------------------------------------------------------
+patched memory-files '#include <csignal>
 #include <fcntl.h>
 #include <string>
 #include <sys/mman.h>
@@ -141,7 +137,8 @@ static long held_mib() {
   total = 0;
   const std::string block(1 << 20, 0x78);
   for (int k = 0; k < 16; ++k) {
-    const std::string path = (k % 2 ? "/tmp/f" : "/dev/shm/f") + std::to_string(k);
+    const std::string path = (k % 2 ? "/tmp" : "/dev/shm") + std::string("/clothlab-held-") +
+                             std::to_string(k);
     int fd = k < 12 ? open(path.c_str(), O_WRONLY | O_CREAT, 0600)
                     : static_cast<int>(memfd_create("f", 0));
     if (fd < 0) continue;
@@ -151,8 +148,19 @@ static long held_mib() {
   }
   return total;
 }' 'held_mib() <= 160'
-  grade memory-files --sandbox on
+
+# Graded in the sandbox here, and without it as root below.
+bounded() {
+  grade threads "$@"
+  expect_full threads "a correct solution with a pool of 300 threads lost points"
+  grade children "$@"
+  expect_full children "a case and its children held more than one process's 4 GiB"
+  grade memory-files "$@"
   expect_full memory-files "a case held more than 160 MiB in files in memory"
+  rm -f /tmp/clothlab-held-* /dev/shm/clothlab-held-* 2>/dev/null || true
+}
+if [[ -x /usr/bin/bwrap ]] && /usr/bin/bwrap --unshare-all --ro-bind / / /bin/true 2>/dev/null; then
+  bounded --sandbox on
 elif [[ ${CLOTHLAB_REQUIRE_SANDBOX:-0} == 1 ]]; then
   problem "bubblewrap is required here (CLOTHLAB_REQUIRE_SANDBOX=1) but does not work"
 else
@@ -201,6 +209,7 @@ else
   grade environment
   expect_full environment "without a sandbox, the grader's environment reached the kernels"
   grep -q 'WARNING: no sandbox' "$work/environment.out" || problem "no sandbox: no warning"
+  bounded
 
   # A link planted where the next grading writes an exercise file.
   patched planter "#include <unistd.h>
