@@ -42,6 +42,7 @@ void write_new_file(const fs::path& path, const std::string& text) {
   fs::remove(path, ec);  // a link itself, not what it points to
   const int fd = open(path.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_NOFOLLOW | O_CLOEXEC, 0644);
   if (fd < 0) throw std::system_error(errno, std::generic_category(), "creating " + path.string());
+  fchmod(fd, 0644);  // whatever the umask: a confined build reads it as another user
   std::size_t done = 0;
   while (done < text.size()) {
     const ssize_t wrote = write(fd, text.data() + done, text.size() - done);
@@ -410,6 +411,7 @@ SubmissionBuild build_submission(const std::string& submission_dir, const std::s
   const fs::path build = scratch / "build";
   fs::create_directories(exercises);
   fs::create_directories(build);
+  if (fresh) chmod(exercises.c_str(), 0755);
 
   // The submission's files over the stubs, file by file.
   const std::vector<ExerciseFile> files = kit_exercises(kit);

@@ -66,13 +66,18 @@ scratch_mib() { du -sm "$work/scratch" | cut -f1; }
 # --- the environment --------------------------------------------------------------------------
 patched environment '#include <cstring>
 #include <unistd.h>
-// True when the environment holds PATH, LANG and HOME, and nothing else.
+// True when the environment holds PATH, LANG and HOME, and nothing else (but the sanitizer's
+// options, in a sanitized build).
 static bool only_three() {
   int count = 0;
-  for (char** e = environ; *e != nullptr; ++e, ++count)
+  for (char** e = environ; *e != nullptr; ++e, ++count) {
+#if defined(__SANITIZE_ADDRESS__)
+    if (std::strncmp(*e, "ASAN_OPTIONS=", 13) == 0) { --count; continue; }
+#endif
     if (std::strncmp(*e, "PATH=", 5) != 0 && std::strncmp(*e, "LANG=", 5) != 0 &&
         std::strncmp(*e, "HOME=", 5) != 0)
       return false;
+  }
   return count == 3;
 }' 'only_three()'
 CLOTHLAB_GRADER_SECRET=leaked grade environment
