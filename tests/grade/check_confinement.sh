@@ -66,8 +66,8 @@ scratch_mib() { du -sm "$work/scratch" | cut -f1; }
 # --- the environment --------------------------------------------------------------------------
 patched environment '#include <cstring>
 #include <unistd.h>
-// True when the environment holds PATH, LANG and HOME, and nothing else (but the sanitizer's
-// options, in a sanitized build).
+// True when the environment holds PATH, LANG and HOME, and nothing else (but ASAN_OPTIONS
+// in a sanitized build).
 static bool only_three() {
   int count = 0;
   for (char** e = environ; *e != nullptr; ++e, ++count) {
@@ -251,6 +251,13 @@ static bool spoil() {
   expect_full honest "--sandbox off --kernels-as-root"
   grep -q 'WARNING: no sandbox (--sandbox off)' "$work/honest.out" ||
     problem "--sandbox off --kernels-as-root: no warning"
+  # Even as root, the kernels write no file: not the grading binary.
+  patched replacer "#include <fstream>
+static bool replace() {
+  std::ofstream(\"$copy/grade-cases\") << \"replaced\";
+  return true;
+}" 'replace()'
+  grade replacer --sandbox off --kernels-as-root
   [[ $(sum) == "$before" ]] || problem "the grading binary changed"
 fi
 
