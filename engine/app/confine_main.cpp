@@ -61,13 +61,17 @@ constexpr unsigned kNoSuchCall = SECCOMP_RET_ERRNO | ENOSYS;
 // --no-writes. (open and openat are refused only when their flags ask to write or create.)
 constexpr long kWriteCalls[] = {
 #if defined(__x86_64__)
-    SYS_creat,      SYS_mkdir,    SYS_rmdir,     SYS_unlink,   SYS_rename,    SYS_link,
-    SYS_symlink,    SYS_truncate, SYS_mknod,     SYS_chmod,    SYS_chown,     SYS_lchown,
+    SYS_creat,     SYS_mkdir,    SYS_rmdir,     SYS_unlink,    SYS_rename,
+    SYS_link,      SYS_symlink,  SYS_truncate,  SYS_mknod,     SYS_chmod,
+    SYS_chown,     SYS_lchown,   SYS_renameat,
 #endif
-    SYS_mkdirat,    SYS_unlinkat, SYS_renameat2, SYS_linkat,   SYS_symlinkat, SYS_mknodat,
-    SYS_fchmodat,   SYS_fchownat, SYS_utimensat, SYS_setxattr, SYS_lsetxattr, SYS_socket,
-    SYS_socketpair,
-};
+    SYS_mkdirat,   SYS_unlinkat, SYS_renameat2, SYS_linkat,    SYS_symlinkat,
+    SYS_mknodat,   SYS_fchmodat, SYS_fchownat,  SYS_utimensat, SYS_setxattr,
+    SYS_lsetxattr, SYS_socket,   SYS_socketpair};
+// And what only root may do, were the kernels root (--sandbox off --kernels-as-root).
+constexpr long kRootCalls[] = {SYS_mount,       SYS_umount2,      SYS_pivot_root,    SYS_chroot,
+                               SYS_init_module, SYS_finit_module, SYS_delete_module, SYS_reboot,
+                               SYS_swapon,      SYS_swapoff,      SYS_kexec_load};
 
 bool load_filter(bool no_writes) {
   constexpr unsigned kArgLow = offsetof(seccomp_data, args[0]);  // little-endian: the low word
@@ -107,6 +111,8 @@ bool load_filter(bool no_writes) {
     deny(nr, kDeny);
   if (no_writes) {
     for (const long nr : kWriteCalls)
+      deny(nr, kDeny);
+    for (const long nr : kRootCalls)
       deny(nr, kDeny);
     deny(SYS_openat2, kNoSuchCall);  // its flags are in memory: the C library falls back to openat
     constexpr unsigned kWriting = O_WRONLY | O_RDWR | O_CREAT | O_TRUNC;

@@ -249,10 +249,13 @@ void grade(const Options& o) {
                                        : "bubblewrap is not installed, or cannot make namespaces "
                                          "here")
                 << "): the submission's code runs as "
-                << (confinement.user.empty() ? as_root ? "root" : "this user" : "the user nobody")
-                << " and can read whatever that user can, the solutions and hidden tests "
-                   "included"
-                << (as_root ? ", and change any file of this machine, the grader's own" : "")
+                << (!confinement.user.empty()
+                        ? "the user nobody and can read whatever nobody can, the solutions "
+                          "included (not the hidden tests)"
+                    : as_root ? "root and can read anything on this machine, the solutions and "
+                                "hidden tests included, and signal any process"
+                              : "this user and can read whatever this user can, the solutions "
+                                "and hidden tests included")
                 << ". Install bubblewrap (Debian: apt-get install bubblewrap), or grade on "
                    "a machine that holds nothing else.\n";
     }
