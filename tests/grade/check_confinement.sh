@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # check_confinement.sh CLOTHLAB SOURCE WORK_DIR: what bounds a submission as a whole, graded with
 # `clothlab grade --submission` on lesson 01 (14 points, 2 of them on the gravity kernel):
-# - its environment is PATH, LANG and HOME alone, in every mode;
+# - its environment is PATH, LANG and HOME alone, in every mode, and so is its compiler's;
 # - a case is one process with threads (a pool of 300 keeps its points), its memory is bounded as a
 #   whole (no child processes to hold more) and so are its files in memory (/tmp, /dev/shm);
 # - its build writes no file over the limit and leaves nothing in the scratch folder;
@@ -215,6 +215,12 @@ else
   expect_full environment "without a sandbox, the grader's environment reached the kernels"
   grep -q 'WARNING: no sandbox' "$work/environment.out" || problem "no sandbox: no warning"
   bounded
+  # Nor does it reach the compiler: a CPATH set for the grader would find the solution by a
+  # header's name the include filter lets pass.
+  mkdir -p "$work/cpath"
+  echo "#include <$name>" >"$work/cpath/$name"
+  CPATH=$source_dir/solutions grade cpath
+  [[ $score == 0 ]] || problem "cpath: the grader's CPATH reached the compiler (score $score)"
 
   # A link planted where the next grading writes an exercise file.
   patched planter "#include <unistd.h>
