@@ -3,12 +3,14 @@
 
 #include <fcntl.h>
 #include <sys/file.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <fmt/core.h>
 
 #include <algorithm>
 #include <cctype>
+#include <cerrno>
 #include <cstdint>
 #include <filesystem>
 #include <fstream>
@@ -31,8 +33,32 @@ std::string read_text(const fs::path& path) {
   return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
 }
 
+// Writes `text` to a new file at `path`, in place of whatever was there: what was there is
+// unlinked, never followed (a symbolic link planted there would have the grader write where it
+// points), and the file is made anew (O_EXCL), so that nothing is written through a link that
+// appears meanwhile.
+void write_new_file(const fs::path& path, const std::string& text) {
+  std::error_code ec;
+  fs::remove(path, ec);  // a link itself, not what it points to
+  const int fd = open(path.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_NOFOLLOW | O_CLOEXEC, 0644);
+  if (fd < 0) throw std::system_error(errno, std::generic_category(), "creating " + path.string());
+  fchmod(fd, 0644);  // whatever the umask: a confined build reads it as another user
+  std::size_t done = 0;
+  while (done < text.size()) {
+    const ssize_t wrote = write(fd, text.data() + done, text.size() - done);
+    if (wrote < 0 && errno == EINTR) continue;
+    if (wrote <= 0) {
+      const int error = errno;
+      close(fd);
+      throw std::system_error(error, std::generic_category(), "writing " + path.string());
+    }
+    done += static_cast<std::size_t>(wrote);
+  }
+  close(fd);
+}
+
 // Puts the exercise file `from` into the scratch folder as `to`, so that the scratch build
-// recompiles only the files that changed since it last ran: copied only when the contents
+// recompiles only the files that changed since it last ran: written only when the contents
 // differ, and left out when it is its shipped `stub` as is (the kit links the stub's object,
 // which the project's build already compiled).
 void take_file(const fs::path& from, const fs::path& to, const fs::path& stub) {
@@ -41,8 +67,8 @@ void take_file(const fs::path& from, const fs::path& to, const fs::path& stub) {
     fs::remove(to);
     return;
   }
-  if (fs::exists(to) && text == read_text(to)) return;
-  fs::copy_file(from, to, fs::copy_options::overwrite_existing);
+  if (fs::is_regular_file(fs::symlink_status(to)) && text == read_text(to)) return;
+  write_new_file(to, text);
 }
 
 // One exercise file of the project and the shipped stub of it, as the kit lists them.
@@ -65,6 +91,9 @@ std::vector<ExerciseFile> kit_exercises(const fs::path& kit) {
 }
 
 constexpr std::uintmax_t kMaxFileBytes = 1 << 20;  // an exercise file is a few kilobytes
+// Any file a submission's build writes: an object of an exercise file is well under a megabyte,
+// the kernels program a few (a 1 GB object, a large array's zeros spelt out, is refused).
+constexpr std::size_t kMaxBuildFileBytes = std::size_t{64} << 20;
 
 // Where a submission keeps `name`: at its top, or in an exercises/ folder (a copy of the
 // starter repository). Empty when it has neither, or when what it has there is refused: only a
@@ -357,7 +386,23 @@ SubmissionBuild build_submission(const std::string& submission_dir, const std::s
     fd = lock(scratch, true);
     own_folder = true;
   }
-  result.hold = std::shared_ptr<void>(nullptr, [fd, scratch, own_folder](void*) {
+  // A submission (built with a confinement) starts in a fresh folder: nothing an earlier one
+  // compiled or changed there (its objects, its CMakeCache.txt, a link planted in exercises/)
+  // reaches it, and nothing of it is left once it has been graded. The student's own exercises
+  // keep their build, so that only what changed is compiled again.
+  const bool fresh = confinement != nullptr;
+  const auto clear = [](const fs::path& dir) {
+    std::error_code ignored;
+    fs::remove_all(dir / "exercises", ignored);
+    fs::remove_all(dir / "build", ignored);
+  };
+  if (fresh) {
+    clear(scratch);
+    // The folder is the grader's, whoever an older grader had given it to.
+    if (geteuid() == 0 && lchown(scratch.c_str(), 0, 0) == 0) chmod(scratch.c_str(), 0755);
+  }
+  result.hold = std::shared_ptr<void>(nullptr, [fd, scratch, own_folder, fresh, clear](void*) {
+    if (fresh) clear(scratch);
     if (fd >= 0) close(fd);
     std::error_code ignored;
     if (own_folder) fs::remove_all(scratch, ignored);
@@ -366,6 +411,7 @@ SubmissionBuild build_submission(const std::string& submission_dir, const std::s
   const fs::path build = scratch / "build";
   fs::create_directories(exercises);
   fs::create_directories(build);
+  if (fresh) chmod(exercises.c_str(), 0755);
 
   // The submission's files over the stubs, file by file.
   const std::vector<ExerciseFile> files = kit_exercises(kit);
@@ -408,19 +454,10 @@ SubmissionBuild build_submission(const std::string& submission_dir, const std::s
   // A binary left from the submission graded before must never be graded for this one.
   const fs::path binary = build / "grade-kernels";
   fs::remove(binary, ec);
-  // Nor may a confined build find another submission's objects to read: it compiles afresh.
+  // The build alone is the confined user's: the exercise files stay the grader's, who writes them.
   std::vector<std::string> confined;
   if (confinement != nullptr) {
-    std::vector<fs::path> objects;
-    for (auto it = fs::recursive_directory_iterator(build, ec); !ec && it != fs::end(it);
-         it.increment(ec)) {
-      const fs::path& p = it->path();
-      if (p.extension() == ".o" || p.extension() == ".a" || p.string().ends_with(".o.d"))
-        objects.push_back(p);
-    }
-    for (const fs::path& p : objects)
-      fs::remove(p, ec);
-    hand_over(*confinement, scratch.string());
+    hand_over(*confinement, build.string());
     confined = confinement->build(kit_inputs(), scratch.string());
   }
 
@@ -463,7 +500,7 @@ SubmissionBuild build_submission(const std::string& submission_dir, const std::s
   ProcessLimits limits;
   limits.memory_bytes = std::size_t{4} << 30;
   limits.cpu_seconds = timeout;
-  limits.file_bytes = std::size_t{1} << 30;
+  limits.file_bytes = kMaxBuildFileBytes;
   ProcessResult compile = run_process(args, timeout, limits);
   result.log += shown(compile.output);
 
@@ -495,6 +532,13 @@ SubmissionBuild build_submission(const std::string& submission_dir, const std::s
   } else {
     result.built = true;
     result.binary = binary.string();
+  }
+  // A tool that wrote past the limit was stopped by SIGXFSZ, which its own words do not say.
+  if (!result.built && compile.output.find("File size limit exceeded") != std::string::npos) {
+    result.first_error = fmt::format(
+        "the build wrote a file larger than {} MiB (the limit on any file it writes: a large "
+        "array with an initial value, say, spelt out in the object file)\n{}",
+        kMaxBuildFileBytes >> 20, result.first_error);
   }
   return result;
 }

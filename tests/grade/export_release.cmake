@@ -97,8 +97,11 @@ cd "$root/source/clothlab"
 cmake -S . -B build
 cmake --build build --parallel "$(nproc)" --target clothlab grade-kit
 # A submission's code runs as the user nobody (and in a sandbox where the container allows one):
-# the hidden tests' sources and the grading binary that holds them are root's alone.
-chmod -R go-rwx tests/grade-hidden build/grade-cases 2>/dev/null || true
+# the hidden tests' sources, the grading binary and the objects that hold them and the lists of
+# their names are root's alone (the grader, as root, sees to it again each time it grades).
+chmod -R go-rwx tests/grade-hidden build/grade-cases \
+  build/tests/grade/CMakeFiles/clothlab_grade_tests.dir build/tests/grade/grade-cases_* \
+  2>/dev/null || true
 ]=])
 file(WRITE ${OUT}/run_autograder [=[#!/usr/bin/env bash
 # Gradescope runs this for every submission: it grades the exercise files in

@@ -53,6 +53,7 @@ struct Options {
   std::string scratch;     // where a submission is built; default <dir of clothlab>/grade-scratch
   double build_timeout = 600;    // [s] for configuring, then for compiling, a submission
   std::string sandbox = "auto";  // a submission's cases in bubblewrap: auto, on or off
+  bool kernels_as_root = false;  // --sandbox off as root: said twice, so run the kernels as root
   bool autolab = false;          // end with Autolab's one-line JSON score summary
   std::string classroom;         // write a GitHub Classroom workflow here, and grade nothing
   bool hidden = false;           // also the hidden cases of tests/grade-hidden/ (instructors)
@@ -226,22 +227,40 @@ void grade(const Options& o) {
   // sandbox where it works (sandbox.hpp); where it does not, the grader says loudly what the
   // submission can then do.
   Confinement confinement;
-  if (submission && o.sandbox != "off") {
+  if (submission) {
     std::string warnings;
-    confinement = confine(o.sandbox, kit_inputs(), warnings);
+    if (o.sandbox != "off") confinement = confine(o.sandbox, kit_inputs(), warnings);
     std::cout << std::flush;
     if (!warnings.empty()) std::cerr << "clothlab grade: warning: " << warnings;
     if (confinement.bwrap.empty() && o.sandbox == "on")
       fail(kExitBadInput,
            "--sandbox on: bubblewrap (bwrap) is not installed or cannot make namespaces here");
+    const bool as_root = geteuid() == 0 && confinement.user.empty();
+    if (o.sandbox == "off" && as_root && !o.kernels_as_root) {
+      fail(kExitBadInput,
+           "--sandbox off as root: the submission's code would run as root, with no sandbox, and "
+           "could change the grading binary and so every later grade. Grade with --sandbox auto "
+           "(the user nobody, and bubblewrap where it works), or, on a machine that holds nothing "
+           "else, say it twice: --sandbox off --kernels-as-root");
+    }
     if (confinement.bwrap.empty()) {
-      std::cerr << "clothlab grade: WARNING: no sandbox (bubblewrap is not installed, or cannot "
-                   "make namespaces here): the submission's code runs as "
-                << (confinement.user.empty() ? "this user" : "the user nobody")
-                << " and can read whatever that user can, the solutions and hidden tests "
-                   "included. Install bubblewrap (Debian: apt-get install bubblewrap), or grade on "
+      std::cerr << "clothlab grade: WARNING: no sandbox ("
+                << (o.sandbox == "off" ? "--sandbox off"
+                                       : "bubblewrap is not installed, or cannot make namespaces "
+                                         "here")
+                << "): the submission's code runs as "
+                << (!confinement.user.empty()
+                        ? "the user nobody and can read whatever nobody can, the solutions "
+                          "included (not the hidden tests)"
+                    : as_root ? "root and can read anything on this machine, the solutions and "
+                                "hidden tests included, and signal any process"
+                              : "this user and can read whatever this user can, the solutions "
+                                "and hidden tests included")
+                << ". Install bubblewrap (Debian: apt-get install bubblewrap), or grade on "
                    "a machine that holds nothing else.\n";
     }
+    // What holds the hidden tests is root's alone, wherever the submission's code runs.
+    if (geteuid() == 0) keep_hidden_tests_to_owner(build_dir(), CLOTHLAB_SOURCE_DIR);
   }
   if (submission) {
     notes = "Submission: " + o.submission + "\n";
@@ -251,7 +270,7 @@ void grade(const Options& o) {
     SubmissionBuild build;
     try {
       build = build_submission(o.submission, o.scratch.empty() ? default_scratch() : o.scratch,
-                               o.build_timeout, false, o.sandbox != "off" ? &confinement : nullptr);
+                               o.build_timeout, false, &confinement);
     } catch (const std::exception& e) {
       fail(kExitBadInput, e.what());
     }
@@ -273,7 +292,8 @@ void grade(const Options& o) {
     compiled = !grader.kernels.empty();
     fmt::print("{}", notes);
   }
-  if (submission && o.sandbox != "off") grader.sandbox = confinement.kernels(grader.kernels);
+  if (submission && compiled)
+    grader.sandbox = confinement.kernels(built_program("grade-confine"), grader.kernels);
   for (std::size_t i = 0; compiled && i < cases.size() && !g_interrupted; ++i) {
     if (cases[i].done) continue;  // not compiled
     if (colour) fmt::print("\r\033[K[{}/{}] {}", i + 1, cases.size(), cases[i].name.substr(0, 70));
@@ -434,6 +454,9 @@ void add_grade_command(CLI::App& app) {
                   "(refuse to grade without it) or off")
       ->check(CLI::IsMember({"auto", "on", "off"}))
       ->capture_default_str();
+  cmd->add_flag("--kernels-as-root", o->kernels_as_root,
+                "With --sandbox off as root: run the submission's code as root all the same (on a "
+                "machine that holds nothing else)");
   cmd->add_flag("--autolab", o->autolab,
                 "End with Autolab's one-line JSON summary of the scores per exercise");
   cmd->add_option("--classroom", o->classroom,
