@@ -227,9 +227,9 @@ if [[ -x /usr/bin/bwrap ]] && /usr/bin/bwrap --unshare-all --ro-bind / / /bin/tr
     problem "writer: a submission wrote into the project's exercises/"
     rm -f "$planted"
   fi
-  # Before main, the kernels' pipes are still its standard input and output: a submission that
-  # hands them to the reference kernels would score what the reference does, were the build
-  # folder visible.
+  # Before main, the kernels' wire (descriptor 3) is open, as it must be: a submission that hands
+  # it to the reference kernels would score what the reference does, were the build folder
+  # visible.
   mkdir -p "$work/exec-reference"
   reference=$(dirname "$clothlab")/grade-kernels-reference
   { cat "$stub"; printf '%s\n' '#include <unistd.h>' \
