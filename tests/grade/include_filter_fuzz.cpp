@@ -178,9 +178,9 @@ int main(int argc, char** argv) {
       {"\"clothlab/ok.hpp\"", false},
   };
 
-  // Each option alone (the eight spellings of the issue among them), with a target outside and
-  // an allowed one; each line before, and each form with each target, plainly spelled; then
-  // `random_count` variants drawn at random from every option of every part.
+  // Each option alone (eight spellings an earlier filter let through among them), with a target
+  // outside and an allowed one; each line before, and each form with each target, plainly spelled;
+  // then `random_count` variants drawn at random from every option of every part.
   struct Variant {
     std::string text, what;
     const Target* target;
