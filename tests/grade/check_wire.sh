@@ -42,6 +42,7 @@ grade() {
 # replaced FILE EXERCISE[@N] BODY: the solution FILE with the region of EXERCISE (BEGIN to END,
 # its Nth, 1 unless told) replaced by BODY.
 replaced() {
+  [[ -n ${preamble:-} ]] && printf '%s\n' "$preamble"
   local exercise=${2%@*} nth=1
   [[ $2 == *@* ]] && nth=${2#*@}
   awk -v ex="$exercise" -v nth="$nth" -v body="$3" '
@@ -127,6 +128,29 @@ hostile hash-slot 10_collision_detection.cpp ex10.1@2 ex10.2 "cell_hash returned
 hostile tears-index 06_plasticity_and_tearing.cpp ex06.2 ex06.1 "select_tears returned the spring index" '
   (void)ends, (void)tear_strain, (void)max_tears;
   return {strain.size() + 7};'
+
+# A message forged on the wire: an answer of bending_pairs whose count claims a pair for every
+# byte of its 64 MiB. Read as it claims, it would have the grading binary allocate 1 GiB; the
+# count is checked against the 16 bytes a pair takes before anything is allocated.
+preamble='#include <unistd.h>
+#include <cstdint>
+#include <cstring>
+#include <vector>'
+hostile forged-count 04_bending_springs.cpp ex04.1 "" "(a message holds fewer values than it says in its answer)" '
+  static std::vector<char> payload(std::size_t{64} << 20);
+  const std::uint64_t count = payload.size() - 8;
+  std::memcpy(payload.data(), &count, sizeof count);
+  const std::uint32_t kind_kernel[2] = {2, 8};  // Return, bending_pairs
+  const std::uint64_t size = payload.size();
+  if (write(3, kind_kernel, sizeof kind_kernel) < 0 || write(3, &size, sizeof size) < 0) _exit(1);
+  for (std::size_t at = 0; at < payload.size();) {
+    const ssize_t n = write(3, payload.data() + at, payload.size() - at);
+    if (n <= 0) break;
+    at += static_cast<std::size_t>(n);
+  }
+  _exit(0);
+  (void)rows, (void)cols;'
+preamble=
 
 # --- an honest submission that prints 2 MiB before main -----------------------------------------
 # A static object's constructor runs before main, before the kernels' process could move its
