@@ -240,7 +240,7 @@ if [[ -x /usr/bin/bwrap ]] && /usr/bin/bwrap --unshare-all --ro-bind / / /bin/tr
     problem "writer: a submission wrote into the project's exercises/"
     rm -f "$planted"
   fi
-  # Before main, the kernels' wire (descriptor 3) is open, as it must be: a submission that hands
+  # Before main, the kernels' wire (descriptors 3 and 4) is open, as it must be: a submission that hands
   # it to the reference kernels would score what the reference does, were the build folder
   # visible.
   mkdir -p "$work/exec-reference"

@@ -142,9 +142,9 @@ hostile forged-count 04_bending_springs.cpp ex04.1 "" "(a message holds fewer va
   std::memcpy(payload.data(), &count, sizeof count);
   const std::uint32_t kind_kernel[2] = {2, 8};  // Return, bending_pairs
   const std::uint64_t size = payload.size();
-  if (write(3, kind_kernel, sizeof kind_kernel) < 0 || write(3, &size, sizeof size) < 0) _exit(1);
+  if (write(4, kind_kernel, sizeof kind_kernel) < 0 || write(4, &size, sizeof size) < 0) _exit(1);
   for (std::size_t at = 0; at < payload.size();) {
-    const ssize_t n = write(3, payload.data() + at, payload.size() - at);
+    const ssize_t n = write(4, payload.data() + at, payload.size() - at);
     if (n <= 0) break;
     at += static_cast<std::size_t>(n);
   }

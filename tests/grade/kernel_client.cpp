@@ -10,7 +10,6 @@
 #include <fcntl.h>
 #include <signal.h>
 #include <sys/prctl.h>
-#include <sys/socket.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -129,33 +128,34 @@ class Kernels {
     prctl(PR_SET_DUMPABLE, 0);
 #endif
     signal(SIGPIPE, SIG_IGN);  // a write to a dead kernels' process fails instead of killing us
-    int wire[2];
-    if (socketpair(AF_UNIX, SOCK_STREAM | SOCK_CLOEXEC, 0, wire) != 0)
-      throw std::runtime_error("cannot make the kernels' wire");
+    int calls[2], answers[2];
+    if (pipe2(calls, O_CLOEXEC) != 0 || pipe2(answers, O_CLOEXEC) != 0)
+      throw std::runtime_error("cannot make the kernels' pipes");
     const pid_t pid = fork();
     if (pid < 0) throw std::runtime_error("cannot start the kernels' process");
     if (pid == 0) {
-      // The wire goes as descriptor kWireFd, and nothing else of this process: every other
-      // descriptor (the grader's events among them) is closed. The standard input reads
-      // nothing; the standard output joins the standard error, the case's log.
-      if (wire[1] == kWireFd) {
-        fcntl(kWireFd, F_SETFD, 0);
-      } else {
-        dup2(wire[1], kWireFd);
-      }
+      // The two pipes go as descriptors kWireIn and kWireOut, and nothing else of this process:
+      // every other descriptor (the grader's events among them) is closed. The standard input
+      // reads nothing; the standard output joins the standard error, the case's log. (Each pipe
+      // is first moved above both numbers, so that neither dup2 lands on the other's pipe.)
+      const int in = fcntl(calls[0], F_DUPFD, kWireOut + 1);
+      const int out = fcntl(answers[1], F_DUPFD, kWireOut + 1);
+      dup2(in, kWireIn);
+      dup2(out, kWireOut);
       const int null_fd = open("/dev/null", O_RDONLY);
       if (null_fd > 0) dup2(null_fd, STDIN_FILENO);
       dup2(STDERR_FILENO, STDOUT_FILENO);
-      close_range(kWireFd + 1, ~0U, 0);
+      close_range(kWireOut + 1, ~0U, 0);
       signal(SIGPIPE, SIG_DFL);
       execv(argv[0], argv.data());
       const char message[] = "cannot execute the kernels' program (CLOTHLAB_KERNELS)\n";
       [[maybe_unused]] auto ignored = write(STDERR_FILENO, message, sizeof message - 1);
       _exit(127);
     }
-    close(wire[1]);
+    close(calls[0]);
+    close(answers[1]);
     pid_ = pid;
-    channel_ = Channel(wire[0], wire[0]);
+    channel_ = Channel(answers[0], calls[1]);
   }
 
   pid_t pid_ = 0;

@@ -7,10 +7,11 @@
 // computes the answer and sends it back. Whatever the kernels' process prints, exits with or
 // fakes, the verdict is written by a process it cannot reach.
 //
-// The wire is a socket of its own, descriptor 3 of the kernels' process (kWireFd), from its first
-// instruction on: its standard output and error are the case's log, which the grader reads and
-// bounds, so that a static object's constructor that prints before main reaches the log, never
-// the wire.
+// The wire is a pair of pipes of its own, descriptors 3 (calls in) and 4 (answers out) of the
+// kernels' process (kWireIn, kWireOut), from its first instruction on: its standard output and
+// error are the case's log, which the grader reads and bounds, so that a static object's
+// constructor that prints before main reaches the log, never the wire. (Pipes rather than a
+// socket: a call's round trip costs less.)
 //
 // A message is a header (kind, kernel, payload size) and a payload of plain values in the
 // machine's byte order (both processes run on one machine):
@@ -134,8 +135,9 @@ struct Header {
   std::uint64_t size = 0;
 };
 
-// The kernels' end of the wire: a descriptor number, the same in every kernels' process.
-constexpr int kWireFd = 3;
+// The kernels' ends of the wire: descriptor numbers, the same in every kernels' process.
+constexpr int kWireIn = 3;   // calls come in here
+constexpr int kWireOut = 4;  // answers go out here
 
 // No message is larger: the largest state a grading case steps is a few thousand particles.
 constexpr std::uint64_t kMaxMessage = std::uint64_t{256} << 20;
@@ -347,8 +349,8 @@ struct Message {
   Reader reader() const { return Reader{payload.data(), payload.size()}; }
 };
 
-// Sends and receives whole messages over a socket (or two descriptors, one each way). send()
-// returns false when the other end is gone.
+// Sends and receives whole messages over two file descriptors (a pipe each way). send() returns
+// false when the other end is gone.
 class Channel {
  public:
   Channel() = default;
