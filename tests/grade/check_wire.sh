@@ -129,8 +129,8 @@ hostile tears-index 06_plasticity_and_tearing.cpp ex06.2 ex06.1 "select_tears re
   (void)ends, (void)tear_strain, (void)max_tears;
   return {strain.size() + 7};'
 
-# A message forged on the wire: an answer of bending_pairs whose count claims a pair for every
-# byte of its 64 MiB. Read as it claims, it would have the grading binary allocate 1 GiB; the
+# Messages forged on the wire. An answer of bending_pairs whose count claims a pair for every
+# byte of its 64 MiB: read as it claims, it would have the grading binary allocate 1 GiB; the
 # count is checked against the 16 bytes a pair takes before anything is allocated.
 preamble='#include <unistd.h>
 #include <cstdint>
@@ -150,6 +150,27 @@ hostile forged-count 04_bending_springs.cpp ex04.1 "" "(a message holds fewer va
   }
   _exit(0);
   (void)rows, (void)cols;'
+# A forged exception, with eight bytes after its values: every message is read to its end.
+hostile forged-throw 08_stability.cpp ex08.1 "" "(a message holds more values than its kernel takes in what it threw)" '
+  const char text[] = "an exception with bytes after it";
+  std::vector<char> bytes;
+  const auto add = [&bytes](const void* p, std::size_t n) {
+    bytes.insert(bytes.end(), static_cast<const char*>(p), static_cast<const char*>(p) + n);
+  };
+  const std::uint32_t thrown = 2;  // Thrown::Exception
+  const std::uint64_t a = sizeof text - 1, b = 0, extra = 0;
+  add(&thrown, sizeof thrown);
+  add(&a, sizeof a);
+  add(text, a);
+  add(&b, sizeof b);
+  add(&extra, sizeof extra);
+  const std::uint32_t kind_kernel[2] = {3, 14};  // Throw, largest_stable_dt_explicit_euler
+  const std::uint64_t size = bytes.size();
+  if (write(4, kind_kernel, sizeof kind_kernel) < 0 || write(4, &size, sizeof size) < 0 ||
+      write(4, bytes.data(), bytes.size()) < 0)
+    _exit(1);
+  _exit(0);
+  (void)k, (void)m, (void)c;'
 preamble=
 
 # --- an honest submission that prints 2 MiB before main -----------------------------------------

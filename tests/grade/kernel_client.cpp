@@ -175,6 +175,7 @@ Kernels& kernels() {
   get(r, kind);
   get(r, a);
   get(r, b);
+  r.expect_end();
   switch (kind) {
     case Thrown::NotImplemented:
       throw NotImplemented(a, b);
