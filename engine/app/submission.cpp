@@ -9,7 +9,6 @@
 #include <fmt/core.h>
 
 #include <algorithm>
-#include <cctype>
 #include <cerrno>
 #include <cstdint>
 #include <filesystem>
@@ -20,6 +19,7 @@
 #include <string_view>
 #include <system_error>
 
+#include "app/include_filter.hpp"
 #include "app/process.hpp"
 #include "app/sandbox.hpp"
 
@@ -119,128 +119,6 @@ fs::path find_in_submission(const fs::path& dir, const std::string& name, std::s
     return {};
   }
   return {};
-}
-
-// Joins the lines a backslash continues and blanks out comments, keeping line numbers: what the
-// preprocessor reads as directives, without their disguises.
-std::string directives_view(const std::string& text) {
-  std::string joined;
-  for (std::size_t i = 0; i < text.size(); ++i) {
-    if (text[i] == '\\' && i + 1 < text.size() && text[i + 1] == '\n') {
-      ++i;
-      joined += ' ';  // (the line number drifts by the joins; the message quotes the text too)
-      continue;
-    }
-    joined += text[i];
-  }
-  std::string out;
-  enum { kCode, kLine, kBlock, kString, kChar } state = kCode;
-  for (std::size_t i = 0; i < joined.size(); ++i) {
-    const char c = joined[i];
-    const char next = i + 1 < joined.size() ? joined[i + 1] : '\0';
-    switch (state) {
-      case kCode:
-        if (c == '/' && next == '/') {
-          state = kLine;
-          out += ' ';
-        } else if (c == '/' && next == '*') {
-          state = kBlock;
-          out += ' ';
-          ++i;
-        } else {
-          if (c == '"') state = kString;
-          if (c == '\'') state = kChar;
-          out += c;
-        }
-        break;
-      case kLine:
-        if (c == '\n') {
-          state = kCode;
-          out += c;
-        }
-        break;
-      case kBlock:
-        if (c == '*' && next == '/') {
-          state = kCode;
-          ++i;
-        } else if (c == '\n') {
-          out += c;
-        }
-        break;
-      case kString:
-      case kChar:
-        out += c;
-        if (c == '\\' && next != '\0') {
-          out += next;
-          ++i;
-        } else if ((state == kString && c == '"') || (state == kChar && c == '\'') || c == '\n') {
-          state = kCode;
-        }
-        break;
-    }
-  }
-  return out;
-}
-
-// Why the exercise file `text` may not be compiled, or "": it may include the standard library's
-// and the engine's headers (<...> or "clothlab/..."), by a name that does not climb out of
-// their folders (no "..", not absolute), and nothing else: not a solution, not a grading test,
-// not /etc/passwd or /dev/zero. The assembler's .incbin, which reads any file into the program,
-// is refused too. (The compiler itself also runs under memory and time limits.)
-std::string include_problem(const std::string& name, const std::string& text) {
-  std::istringstream in(directives_view(text));
-  int number = 0;
-  for (std::string line; std::getline(in, line);) {
-    ++number;
-    const auto where = [&](const std::string& what) {
-      return fmt::format("exercises/{}:{}: error: {}", name, number, what);
-    };
-    std::size_t i = line.find_first_not_of(" \t");
-    if (i == std::string::npos) continue;
-    if (line.find("incbin") != std::string::npos)
-      return where("'.incbin' reads a file into the program; an exercise may not use it");
-    if (line.compare(i, 1, "#") == 0) {
-      i += 1;
-    } else if (line.compare(i, 2, "%:") == 0) {
-      i += 2;
-    } else {
-      continue;
-    }
-    i = line.find_first_not_of(" \t", i);
-    if (i == std::string::npos) continue;
-    std::size_t end = i;
-    while (end < line.size() &&
-           (std::isalnum(static_cast<unsigned char>(line[end])) || line[end] == '_'))
-      ++end;
-    const std::string directive = line.substr(i, end - i);
-    if (directive != "include" && directive != "include_next" && directive != "import" &&
-        directive != "embed")
-      continue;
-    const std::size_t open = line.find_first_not_of(" \t", end);
-    const char opener = open == std::string::npos ? '\0' : line[open];
-    const char closer = opener == '<' ? '>' : opener == '"' ? '"' : '\0';
-    const std::size_t close = closer == '\0' ? std::string::npos : line.find(closer, open + 1);
-    if (directive != "include" || close == std::string::npos) {
-      return where(
-          fmt::format("'#{}' with what follows it is not allowed in an exercise file; "
-                      "include a header by name: #include <vector> or #include "
-                      "\"clothlab/...\"",
-                      directive));
-    }
-    const std::string header = line.substr(open + 1, close - open - 1);
-    const bool climbs = header.empty() || header.front() == '/' ||
-                        header.find("..") != std::string::npos ||
-                        header.find('\\') != std::string::npos;
-    const bool allowed = opener == '<' || header.starts_with("clothlab/");
-    if (climbs || !allowed) {
-      return where(fmt::format(
-          "#include {}{}{} is outside the standard library and the engine's headers; an "
-          "exercise may include <...> headers and \"clothlab/...\" ones, by a name without "
-          "\"..\"",
-          opener, header, closer));
-    }
-  }
-  return "";
 }
 
 std::string replace_all(std::string text, const std::string& from, const std::string& to) {

@@ -82,8 +82,21 @@ plant include-disguised "$(printf '#\\\ninclude "/etc/passwd"')"
 plant include-commented '# /* a comment */ include "/etc/passwd"'
 plant include-computed "$(printf '#define WHERE "/etc/passwd"\n#include WHERE')"
 plant incbin 'asm(".incbin \"/etc/passwd\"");'
+# Spellings the preprocessor reads as the directive: a byte-order mark, splices whose backslash
+# is followed by CR LF, a space or a tab, a form feed or a vertical tab after the '#', a lone CR
+# ending the line before, and a raw string that a naive reader takes for the start of a comment.
+plant include-bom $'\xEF\xBB\xBF#include "/etc/passwd"'
+plant include-splice-crlf $'#inc\\\r\nlude "/etc/passwd"'
+plant include-splice-space $'#inc\\ \nlude "/etc/passwd"'
+plant include-splice-tab $'#inc\\\t\nlude "/etc/passwd"'
+plant include-form-feed $'#\finclude "/etc/passwd"'
+plant include-vertical-tab $'#\vinclude "/etc/passwd"'
+plant include-lone-cr $'int x;\r#include "/etc/passwd"'
+plant include-raw-string $'const char* s = R"(a" /* )";\n#include "/etc/passwd"\n// */'
 for sub in include-relative include-absolute include-passwd include-device include-angle \
-  include-disguised include-commented include-computed incbin; do
+  include-disguised include-commented include-computed incbin include-bom include-splice-crlf \
+  include-splice-space include-splice-tab include-form-feed include-vertical-tab include-lone-cr \
+  include-raw-string; do
   start=$SECONDS
   grade "$sub"
   expect_at_most "$sub" 0
@@ -227,9 +240,9 @@ if [[ -x /usr/bin/bwrap ]] && /usr/bin/bwrap --unshare-all --ro-bind / / /bin/tr
     problem "writer: a submission wrote into the project's exercises/"
     rm -f "$planted"
   fi
-  # Before main, the kernels' pipes are still its standard input and output: a submission that
-  # hands them to the reference kernels would score what the reference does, were the build
-  # folder visible.
+  # Before main, the kernels' wire (descriptors 3 and 4) is open, as it must be: a submission that hands
+  # it to the reference kernels would score what the reference does, were the build folder
+  # visible.
   mkdir -p "$work/exec-reference"
   reference=$(dirname "$clothlab")/grade-kernels-reference
   { cat "$stub"; printf '%s\n' '#include <unistd.h>' \

@@ -13,6 +13,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cstdlib>
 #include <exception>
@@ -54,8 +55,7 @@ class Kernels {
       const std::string during = std::string(" during a call of ") + kernel_name(kernel);
       // Its pipes closed: it is ending, or it closed them itself and lives on; it gets two
       // seconds to end before it is stopped.
-      close(channel_.in());
-      close(channel_.out());
+      channel_.close();
       int status = 0;
       pid_t done = 0;
       for (int waited_ms = 0; broke == nullptr && waited_ms < 2000; waited_ms += 5) {
@@ -134,11 +134,18 @@ class Kernels {
     const pid_t pid = fork();
     if (pid < 0) throw std::runtime_error("cannot start the kernels' process");
     if (pid == 0) {
-      // Only the two pipes and the standard error go with it: every other descriptor of this
-      // process (the grader's events among them) is close-on-exec.
-      dup2(calls[0], STDIN_FILENO);
-      dup2(answers[1], STDOUT_FILENO);
-      close_range(3, ~0U, 0);
+      // The two pipes go as descriptors kWireIn and kWireOut, and nothing else of this process:
+      // every other descriptor (the grader's events among them) is closed. The standard input
+      // reads nothing; the standard output joins the standard error, the case's log. (Each pipe
+      // is first moved above both numbers, so that neither dup2 lands on the other's pipe.)
+      const int in = fcntl(calls[0], F_DUPFD, kWireOut + 1);
+      const int out = fcntl(answers[1], F_DUPFD, kWireOut + 1);
+      dup2(in, kWireIn);
+      dup2(out, kWireOut);
+      const int null_fd = open("/dev/null", O_RDONLY);
+      if (null_fd > 0) dup2(null_fd, STDIN_FILENO);
+      dup2(STDERR_FILENO, STDOUT_FILENO);
+      close_range(kWireOut + 1, ~0U, 0);
       signal(SIGPIPE, SIG_DFL);
       execv(argv[0], argv.data());
       const char message[] = "cannot execute the kernels' program (CLOTHLAB_KERNELS)\n";
@@ -168,6 +175,7 @@ Kernels& kernels() {
   get(r, kind);
   get(r, a);
   get(r, b);
+  r.expect_end();
   switch (kind) {
     case Thrown::NotImplemented:
       throw NotImplemented(a, b);
@@ -193,16 +201,21 @@ R call(Kernel kernel, R (*)(Params...), std::type_identity_t<Params>... args) {
   const auto id = static_cast<std::uint32_t>(kernel);
   const Channel& channel = k.channel();
   const AccelerationField* field = nullptr;
+  Index particles = -1;  // the columns of the call's state (its first matrix), which a field gets
   (
       [&](const auto& value) {
-        if constexpr (std::is_same_v<std::decay_t<decltype(value)>, AccelerationField>)
-          field = &value;
+        using Value = std::decay_t<decltype(value)>;
+        if constexpr (std::is_same_v<Value, AccelerationField>) field = &value;
+        if constexpr (std::is_same_v<Value, Matrix3X>) {
+          if (particles < 0) particles = value.cols();
+        }
       }(args),
       ...);
   Writer w;
   (put(w, args), ...);
   if (!channel.send(Kind::Call, kernel, w)) k.ended(id);
   auto values = std::forward_as_tuple(args...);
+  const char* in = "";  // the message being read, for a break of the protocol
   for (;;) {
     Message m;
     const Channel::Received got = channel.receive(m);
@@ -213,6 +226,7 @@ R call(Kernel kernel, R (*)(Params...), std::type_identity_t<Params>... args) {
     try {
       switch (static_cast<Kind>(m.header.kind)) {
         case Kind::Return: {
+          in = " in its answer";
           if constexpr (std::is_void_v<R>) {
             get_outs<Params...>(r, values);
             r.expect_end();
@@ -226,14 +240,17 @@ R call(Kernel kernel, R (*)(Params...), std::type_identity_t<Params>... args) {
           }
         }
         case Kind::Throw:
+          in = " in what it threw";
           rethrow(k, id, r);
         case Kind::Callback: {
           if (field == nullptr) k.ended(id, "a callback from a kernel that takes none");
+          in = " in a call of its AccelerationField";
           get_outs<Params...>(r, values);
+          // The field (the test's, or the world's) reads and writes one column per particle.
           Matrix3X x, v, a;
-          get(r, x);
-          get(r, v);
-          get(r, a);
+          get_shaped(r, x, particles);
+          get_shaped(r, v, particles);
+          get_shaped(r, a, particles);
           r.expect_end();
           Writer reply;
           try {
@@ -251,9 +268,19 @@ R call(Kernel kernel, R (*)(Params...), std::type_identity_t<Params>... args) {
           k.ended(id, "a message out of turn");
       }
     } catch (const WireError& e) {
-      k.ended(id, e.what());
+      k.ended(id, (e.what() + std::string(in)).c_str());
     }
   }
+}
+
+// A kernel's result that indexes what its caller holds (a test, or the engine) must index inside
+// it, or the caller would read and write past the end: one out of range fails the case, as an
+// exception from the kernel would, naming the kernel and the value.
+void check_index(const char* kernel, const char* what, std::int64_t index, std::int64_t size) {
+  if (index >= 0 && index < size) return;
+  throw std::out_of_range(std::string(kernel) + " returned " + what + " " + std::to_string(index) +
+                          ", out of range: it must be at least 0 and less than " +
+                          std::to_string(size));
 }
 
 }  // namespace
@@ -297,7 +324,12 @@ Vec3 fluid_drag_force(const Vec3& v, const Vec3& v_air, double rho, double cd, d
 }
 
 std::vector<IndexPair> bending_pairs(Index rows, Index cols) {
-  return call(CLOTHLAB_KERNEL(bending_pairs), rows, cols);
+  std::vector<IndexPair> pairs = call(CLOTHLAB_KERNEL(bending_pairs), rows, cols);
+  for (const IndexPair& p : pairs) {
+    for (const Index i : {p.first, p.second})
+      check_index("bending_pairs", "the particle index", i, rows * cols);
+  }
+  return pairs;
 }
 
 PointState collision_response(const Vec3& r, const Vec3& v, const Vec3& n, double depth, double e,
@@ -313,7 +345,12 @@ double plastic_rest_length(double l, double l0, double l_built, const PlasticLim
 std::vector<size_t> select_tears(const std::vector<double>& strain,
                                  const std::vector<std::pair<Index, Index>>& ends,
                                  double tear_strain, size_t max_tears) {
-  return call(CLOTHLAB_KERNEL(select_tears), strain, ends, tear_strain, max_tears);
+  std::vector<size_t> torn =
+      call(CLOTHLAB_KERNEL(select_tears), strain, ends, tear_strain, max_tears);
+  const auto springs = static_cast<std::int64_t>(std::min(strain.size(), ends.size()));
+  for (const size_t k : torn)
+    check_index("select_tears", "the spring index", static_cast<std::int64_t>(k), springs);
+  return torn;
 }
 
 void midpoint_step(Matrix3X& x, Matrix3X& v, double dt, const AccelerationField& accel,
@@ -340,7 +377,13 @@ Cell cell_of(const Vec3& x, double h) {
 }
 
 std::size_t cell_hash(const Cell& c, std::size_t table_size) {
-  return call(CLOTHLAB_KERNEL(cell_hash), c, table_size);
+  const std::size_t slot = call(CLOTHLAB_KERNEL(cell_hash), c, table_size);
+  if (slot >= table_size) {
+    throw std::out_of_range("cell_hash returned the slot " + std::to_string(slot) +
+                            ", out of range: it must be less than table_size, " +
+                            std::to_string(table_size));
+  }
+  return slot;
 }
 
 PairState pair_response(const PairState& in, double w1, double w2, const SelfContact& contact) {

@@ -1,10 +1,11 @@
 // kernel_server.cpp: the main of a kernels process (grade-kernels-*), see kernel_wire.hpp.
 //
 // Linked with the engine and one set of kernels (the reference, the shipped stubs, or a
-// submission's), it reads calls on its standard input and answers on its standard output until
-// the input ends. It holds no test and no expected value: it only computes. What the kernels
-// print goes to the standard error, never into the answers' pipe.
+// submission's), it reads calls on the wire (descriptor kWireIn, which the grading binary gives
+// it) and answers on kWireOut until the calls end. It holds no test and no expected value: it only
+// computes. What the kernels print goes to the standard output and error, never onto the wire.
 #include <fcntl.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <cstdio>
@@ -131,14 +132,19 @@ void serve(const Message& call) {
 }  // namespace
 
 int main() {
-  // The answers' pipe moves out of the way; what the kernels print goes to the standard error.
-  const int in = fcntl(STDIN_FILENO, F_DUPFD_CLOEXEC, 3);
-  const int out = fcntl(STDOUT_FILENO, F_DUPFD_CLOEXEC, 3);
-  if (in < 0 || out < 0) give_up("cannot take its pipes");
-  dup2(STDERR_FILENO, STDOUT_FILENO);
-  const int null_fd = open("/dev/null", O_RDONLY | O_CLOEXEC);
-  if (null_fd >= 0) dup2(null_fd, STDIN_FILENO);
-  g_channel = Channel(in, out);
+  // The wire is a pair of pipes the grading binary made for it alone, there from the first
+  // instruction (a static object's constructor runs before main, and may print what it likes:
+  // that goes to the standard output, not here). Programs the kernels start do not get it.
+  for (const int fd : {kWireIn, kWireOut}) {
+    struct stat wire {};
+    if (fstat(fd, &wire) != 0 || !S_ISFIFO(wire.st_mode)) {
+      give_up(
+          "no wire on descriptors 3 and 4: a grading binary starts this program, with the "
+          "command in CLOTHLAB_KERNELS");
+    }
+    fcntl(fd, F_SETFD, FD_CLOEXEC);
+  }
+  g_channel = Channel(kWireIn, kWireOut);
   for (;;) {
     Message m;
     if (g_channel.receive(m) != Channel::Received::Message) return 0;  // the grader is done

@@ -2,10 +2,16 @@
 //
 // A submission's code is hostile until graded. So it never runs in the process that judges it:
 // the grading binary (grade-cases: the tests, the engine, and kernel_client.cpp in place of the
-// kernels) runs the checks, and every call of an exercise kernel goes over a pipe to a kernels
+// kernels) runs the checks, and every call of an exercise kernel goes over a wire to a kernels
 // process (grade-kernels-*: the engine, the kernels under test and kernel_server.cpp), which
 // computes the answer and sends it back. Whatever the kernels' process prints, exits with or
 // fakes, the verdict is written by a process it cannot reach.
+//
+// The wire is a pair of pipes of its own, descriptors 3 (calls in) and 4 (answers out) of the
+// kernels' process (kWireIn, kWireOut), from its first instruction on: its standard output and
+// error are the case's log, which the grader reads and bounds, so that a static object's
+// constructor that prints before main reaches the log, never the wire. (Pipes rather than a
+// socket: a call's round trip costs less.)
 //
 // A message is a header (kind, kernel, payload size) and a payload of plain values in the
 // machine's byte order (both processes run on one machine):
@@ -26,7 +32,10 @@
 //
 // While it waits for a CallbackReturn, the kernels' process serves Calls (a field may run the
 // engine, which calls kernels). The client trusts nothing it reads: every size is checked
-// against the bytes there are, and a message that does not parse ends the kernels' process.
+// against the bytes there are, every matrix against the shape the call fixed (an argument the
+// kernel may change comes back in the shape it had at the call; a callback's x, v and a have one
+// column per particle of the call's state), before any of it is used; a message that does not
+// parse, or a matrix of another shape, ends the kernels' process as a break of the protocol.
 #pragma once
 
 #include <unistd.h>
@@ -126,6 +135,10 @@ struct Header {
   std::uint64_t size = 0;
 };
 
+// The kernels' ends of the wire: descriptor numbers, the same in every kernels' process.
+constexpr int kWireIn = 3;   // calls come in here
+constexpr int kWireOut = 4;  // answers go out here
+
 // No message is larger: the largest state a grading case steps is a few thousand particles.
 constexpr std::uint64_t kMaxMessage = std::uint64_t{256} << 20;
 
@@ -167,6 +180,15 @@ struct Reader {
 template <class T>
 concept Plain = std::is_arithmetic_v<T> || std::is_enum_v<T>;
 
+// The fewest bytes a value of T takes in a message: what a count of them is checked against, so
+// that a count cannot make the reader allocate more than the message's size over again.
+template <class T>
+constexpr std::size_t kMinBytes = 1;
+template <Plain T>
+constexpr std::size_t kMinBytes<T> = sizeof(T);
+template <class A, class B>
+constexpr std::size_t kMinBytes<std::pair<A, B>> = kMinBytes<A> + kMinBytes<B>;
+
 template <Plain T>
 void put(Writer& w, const T& value) {
   w.raw(&value, sizeof value);
@@ -202,6 +224,18 @@ inline void get(Reader& r, Matrix3X& m) {
   r.raw(m.data(), sizeof(double) * 3 * cols);
 }
 
+// A matrix that must have `cols` columns (the shape the call fixed): refused before it is read.
+inline void get_shaped(Reader& r, Matrix3X& m, Index cols) {
+  std::uint64_t n = 0;
+  get(r, n);
+  if (n != static_cast<std::uint64_t>(cols)) {
+    throw WireError("a matrix of 3 x " + std::to_string(n) + " where the call's is 3 x " +
+                    std::to_string(cols));
+  }
+  m.resize(3, cols);
+  r.raw(m.data(), sizeof(double) * 3 * static_cast<std::size_t>(cols));
+}
+
 template <class A, class B>
 void put(Writer& w, const std::pair<A, B>& p) {
   put(w, p.first);
@@ -222,7 +256,7 @@ void put(Writer& w, const std::vector<T>& v) {
 template <class T>
 void get(Reader& r, std::vector<T>& v) {
   v.clear();
-  v.resize(r.count(1));  // every value takes at least one byte
+  v.resize(r.count(kMinBytes<T>));
   for (T& x : v)
     get(r, x);
 }
@@ -271,6 +305,22 @@ template <class Param>
 constexpr bool kIsOut =
     std::is_lvalue_reference_v<Param> && !std::is_const_v<std::remove_reference_t<Param>>;
 
+// An argument the kernel may change comes back in the shape it had at the call: a kernel that
+// resized one would have its caller read and write past the end of what it holds.
+template <class T>
+void get_kept(Reader& r, T& value) {
+  get(r, value);
+}
+inline void get_kept(Reader& r, Matrix3X& m) {
+  get_shaped(r, m, m.cols());
+}
+inline void get_kept(Reader& r, RungeKuttaStages& s) {
+  for (std::array<Matrix3X, 4>* stage : {&s.x, &s.v, &s.a}) {
+    for (Matrix3X& m : *stage)
+      get_kept(r, m);
+  }
+}
+
 // Writes (or reads) the kernel's changeable arguments, in order, from a tuple of its arguments.
 template <class... Params, class Tuple>
 void put_outs(Writer& w, const Tuple& values) {
@@ -284,14 +334,14 @@ void get_outs(Reader& r, Tuple&& values) {
   [&]<std::size_t... I>(std::index_sequence<I...>) {
     (
         [&] {
-          if constexpr (kIsOut<Params>) get(r, std::get<I>(values));
+          if constexpr (kIsOut<Params>) get_kept(r, std::get<I>(values));
         }(),
         ...);
   }
   (std::index_sequence_for<Params...>{});
 }
 
-// --- Messages over a pair of file descriptors ---------------------------------------------------
+// --- Messages over a file descriptor ---------------------------------------------------
 
 struct Message {
   Header header;
@@ -321,8 +371,11 @@ class Channel {
   // between messages, Received::Broken when it stopped mid-message or sent a size beyond
   // kMaxMessage.
   enum class Received { Message, End, Broken };
-  int in() const { return in_; }
-  int out() const { return out_; }
+  // Closes the descriptors (the other end then reads the end of the wire).
+  void close() const {
+    ::close(in_);
+    if (out_ != in_) ::close(out_);
+  }
   Received receive(Message& m) const {
     const Read header = read_all(&m.header, sizeof m.header);
     if (header != Read::All) return header == Read::Nothing ? Received::End : Received::Broken;
