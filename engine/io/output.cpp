@@ -11,30 +11,30 @@
 
 namespace clothlab {
 
-FrameWriter::FrameWriter(const std::filesystem::path& dir, bool velocities, bool springs, bool npy,
+FrameWriter::FrameWriter(const Folder& dir, bool velocities, bool springs, bool npy,
                          Index particles) {
-  files_ = {dir / "energy.csv"};
-  energy_ = AppendFile(files_[0]);
+  files_ = {dir.path() / "energy.csv"};
+  energy_ = AppendFile(dir, "energy.csv");
   energy_.append("frame,t,kinetic,potential,total,px,py,pz\n");
   if (npy) {
-    files_.push_back(dir / "positions.npy");
-    positions_npy_.emplace(files_.back(), particles);
+    files_.push_back(dir.path() / "positions.npy");
+    positions_npy_.emplace(dir, "positions.npy", particles);
   } else {
-    files_.push_back(dir / "positions.csv");
-    positions_ = AppendFile(files_.back());
+    files_.push_back(dir.path() / "positions.csv");
+    positions_ = AppendFile(dir, "positions.csv");
     positions_.append("frame,t,particle,x,y,z\n");
   }
   if (velocities && npy) {
-    files_.push_back(dir / "velocities.npy");
-    velocities_npy_.emplace(files_.back(), particles);
+    files_.push_back(dir.path() / "velocities.npy");
+    velocities_npy_.emplace(dir, "velocities.npy", particles);
   } else if (velocities) {
-    files_.push_back(dir / "velocities.csv");
-    velocities_ = AppendFile(files_.back());
+    files_.push_back(dir.path() / "velocities.csv");
+    velocities_ = AppendFile(dir, "velocities.csv");
     velocities_.append("frame,t,particle,vx,vy,vz\n");
   }
   if (springs) {
-    files_.push_back(dir / "springs.csv");
-    springs_ = AppendFile(files_.back());
+    files_.push_back(dir.path() / "springs.csv");
+    springs_ = AppendFile(dir, "springs.csv");
     springs_.append("frame,t,effect,spring,i,j,strain,tension\n");
   }
 }

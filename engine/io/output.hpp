@@ -31,11 +31,11 @@ namespace clothlab {
 
 class FrameWriter {
  public:
-  // Opens the files in `dir` (which must exist), replacing those of an earlier run; with
-  // `velocities` and `springs`, velocities.csv and springs.csv as well; with `npy`, the
-  // positions (and velocities) of `particles` particles as .npy files instead of CSV.
-  explicit FrameWriter(const std::filesystem::path& dir, bool velocities = false,
-                       bool springs = false, bool npy = false, Index particles = 0);
+  // Opens the files in `dir`, replacing those of an earlier run; with `velocities` and
+  // `springs`, velocities.csv and springs.csv as well; with `npy`, the positions (and
+  // velocities) of `particles` particles as .npy files instead of CSV.
+  explicit FrameWriter(const Folder& dir, bool velocities = false, bool springs = false,
+                       bool npy = false, Index particles = 0);
 
   // Appends frame number `frame` of the world's current state, after step `step`, to every
   // file. Throws SimulationError, before writing, if a value of the frame is not finite; throws

@@ -88,19 +88,25 @@ RunReport run_scene(Scene& scene, const RunOutputs& outputs, const ProgressFn& p
     return !p.has_filename() && p.has_parent_path() ? p.parent_path() : p;
   };
   const bool page_inside = page && folder_of(outputs.html.parent_path()) == folder_of(outputs.dir);
-  if (page && !page_inside) check_page_target(outputs.html, outputs.force);
+  const PageFolderLock page_lock =
+      page && !page_inside ? check_page_target(outputs.html, outputs.force) : PageFolderLock();
   RunFolder folder(outputs.dir, outputs.force);
-  if (page_inside) check_page_target(outputs.html, outputs.force);
-  FrameWriter writer(outputs.dir, outputs.velocities || scene.output.velocities,
+  if (page_inside) check_page_target(outputs.html, outputs.force, /*lock_folder=*/false);
+  FrameWriter writer(folder.folder(), outputs.velocities || scene.output.velocities,
                      outputs.springs || scene.output.springs, outputs.npy || scene.output.npy,
                      scene.world.particles.size());
-  MeshExporter meshes(outputs.dir / "frames", outputs.obj, outputs.vtk);
+  MeshExporter meshes(folder.folder(), "frames", outputs.obj, outputs.vtk);
   RunReport report;
   report.files = writer.files();
 
   const long total = scene.step_count();
-  // A frame every 1/fps seconds: that many steps, rounded, and at least one.
-  const long steps_per_frame = std::max(1L, std::lround(1.0 / (scene.output.fps * scene.dt)));
+  // A frame every 1/fps seconds: that many steps, rounded, at least one and at most the run's
+  // steps (then the first and the last frame only). Clamped as a double: for a tiny fps,
+  // 1 / (fps dt) is past what a long holds, or inf.
+  const double frame_steps = std::round(1.0 / (scene.output.fps * scene.dt));
+  const long steps_per_frame = !(frame_steps < static_cast<double>(std::max(total, 1L)))
+                                   ? std::max(total, 1L)
+                                   : std::max(1L, static_cast<long>(frame_steps));
   // The first frame, one every steps_per_frame steps, and the last if it falls between.
   const long frames = 1 + total / steps_per_frame + (total % steps_per_frame != 0 ? 1 : 0);
   ViewerRecorder viewer(scene.title, scene.source, frames);
@@ -119,7 +125,11 @@ RunReport run_scene(Scene& scene, const RunOutputs& outputs, const ProgressFn& p
   double page_seconds = 0.0;  // how long the last page took to write [s]
   const auto write_page = [&] {
     const Clock::time_point start = Clock::now();
-    viewer.write(world, outputs.html);
+    if (page_inside) {
+      viewer.write(world, folder.folder(), outputs.html.filename().string());
+    } else {
+      viewer.write(world, outputs.html);
+    }
     page_seconds = seconds_since(start);
     last_page = Clock::now();
   };

@@ -2,7 +2,9 @@
 // and no inf or NaN in any file.
 #include <doctest/doctest.h>
 #include <sys/resource.h>
+#include <unistd.h>
 
+#include <algorithm>
 #include <csignal>
 #include <cstring>
 #include <filesystem>
@@ -14,6 +16,7 @@
 
 #include "clothlab/core/guard.hpp"
 #include "io/files.hpp"
+#include "io/npy.hpp"
 #include "io/run.hpp"
 #include "io/run_folder.hpp"
 #include "scene/scene.hpp"
@@ -359,4 +362,192 @@ TEST_CASE("outputs: format npy writes positions.npy in place of positions.csv, f
   std::memcpy(&x0, npy.data() + 128 + 20 * 400 * 3 * 4, sizeof x0);
   CHECK(x0 == static_cast<float>(scene.world.particles.x(0, 0)));
   CHECK(read_all(dir / "velocities.npy").size() == npy.size());
+}
+
+// The symbolic link attack: a link planted where a run writes (in a shared folder such as /tmp,
+// say) must never make the run write, truncate or delete the file or folder it points to.
+namespace {
+
+// A folder of files a run must never touch, each holding "victim NAME\n".
+fs::path make_victims(const std::string& test, const std::vector<std::string>& names) {
+  const fs::path victims = fresh_dir(test + "-victims");
+  fs::create_directories(victims);
+  for (const std::string& name : names)
+    write_text(victims / name, "victim " + name + "\n");
+  return victims;
+}
+
+void check_victims(const fs::path& victims, const std::vector<std::string>& names) {
+  CHECK(names_in(victims) == names);
+  for (const std::string& name : names)
+    CHECK_MESSAGE(read_all(victims / name) == "victim " + name + "\n", name);
+}
+
+}  // namespace
+
+TEST_CASE("outputs: every writer replaces a symbolic link in its place, not the file it names") {
+  const fs::path dir = fresh_dir("writer-links");
+  fs::create_directories(dir);
+  const std::vector<std::string> names = {"append", "npy", "partial", "replace"};
+  const fs::path victims = make_victims("writer-links", names);
+  fs::create_symlink(victims / "append", dir / "rows.csv");
+  fs::create_symlink(victims / "npy", dir / "x.npy");
+  fs::create_symlink(victims / "replace", dir / "page.html");
+  // The temporary file's name is predictable (the process id): a link planted there.
+  fs::create_symlink(victims / "partial", dir / (".page.html.partial-" + std::to_string(getpid())));
+
+  clothlab::AppendFile rows(dir / "rows.csv");
+  rows.append("mine\n");
+  clothlab::NpyFrameWriter npy(dir / "x.npy", 1);
+  npy.append(clothlab::Matrix3X::Zero(3, 1));
+  clothlab::write_whole_file(dir / "page.html", "my page\n");
+
+  check_victims(victims, names);
+  for (const std::string name : {"rows.csv", "x.npy", "page.html"})
+    CHECK_MESSAGE(fs::is_regular_file(fs::symlink_status(dir / name)), name);
+  CHECK(read_all(dir / "rows.csv") == "mine\n");
+  CHECK(read_all(dir / "page.html") == "my page\n");
+  CHECK(names_in(dir) == std::vector<std::string>{"page.html", "rows.csv", "x.npy"});
+}
+
+TEST_CASE("outputs: a marker that is a link or has a second name is refused, its file untouched") {
+  const std::vector<std::string> names = {"marker"};
+  const fs::path victims = make_victims("marker-link", names);
+  const fs::path dir = fresh_dir("marker-link");
+  fs::create_directories(dir);
+  fs::create_symlink(victims / "marker", dir / ".clothlab-run");
+  for (const bool force : {false, true}) {
+    CHECK_THROWS_WITH_AS(clothlab::RunFolder(dir, force),
+                         ((dir / ".clothlab-run").string() +
+                          " is a symbolic link, not clothlab's marker, and a run writes into "
+                          "that file; remove it, or choose another --out")
+                             .c_str(),
+                         OutputError);
+  }
+  // A link to no file at all (which O_CREAT would make): refused too, and nothing made.
+  fs::remove(dir / ".clothlab-run");
+  fs::create_symlink(victims / "new", dir / ".clothlab-run");
+  CHECK_THROWS_WITH_AS(clothlab::RunFolder(dir, true), doctest::Contains("is a symbolic link"),
+                       OutputError);
+  // A hard link: the same file under a second name.
+  fs::remove(dir / ".clothlab-run");
+  fs::create_hard_link(victims / "marker", dir / ".clothlab-run");
+  CHECK_THROWS_WITH_AS(clothlab::RunFolder(dir, true),
+                       doctest::Contains("is a file with other names (hard links), not "
+                                         "clothlab's marker"),
+                       OutputError);
+  fs::remove(dir / ".clothlab-run");
+  check_victims(victims, names);
+
+  // A run folder that is itself a link is not followed.
+  fs::create_directories(victims / "folder");
+  fs::create_symlink(victims / "folder", dir / "out");
+  CHECK_THROWS_WITH_AS(clothlab::RunFolder(dir / "out", true),
+                       ("cannot write into " + (dir / "out").string() +
+                        ": it is a symbolic link, which a run does not follow; give the folder "
+                        "it points to as --out")
+                           .c_str(),
+                       OutputError);
+  CHECK(fs::is_empty(victims / "folder"));
+}
+
+TEST_CASE("outputs: links in a run folder are removed as names; what they point to is kept") {
+  const fs::path dir = fresh_dir("folder-links");
+  const auto run = [&](bool npy) {
+    std::string text = kCloth;
+    text += npy ? "velocities = true\nformat = \"npy\"\n" : "velocities = true\nsprings = true\n";
+    clothlab::Scene scene = clothlab::parse_scene(text, "<cloth>");
+    clothlab::RunOutputs outputs = clothlab::RunOutputs::in(dir);
+    outputs.obj = outputs.vtk = true;
+    return clothlab::run_scene(scene, outputs);
+  };
+  run(false);  // the folder is clothlab's now: a marker, outputs and frames
+  const std::vector<std::string> outputs = {"energy.csv",  "positions.csv",       "velocities.csv",
+                                            "springs.csv", "positions.npy",       "velocities.npy",
+                                            "view.html",   ".view.html.partial-1"};
+  std::vector<std::string> names = outputs;
+  names.push_back("frames");
+  std::sort(names.begin(), names.end());
+  const fs::path victims = make_victims("folder-links", names);
+  fs::remove(victims / "frames");
+  fs::create_directories(victims / "frames");
+  const std::vector<std::string> frames = {"frame_0001.obj", "frame_0002.vtk", "frames.vtk.series"};
+  for (const std::string& frame : frames)
+    write_text(victims / "frames" / frame, "victim frame\n");
+
+  for (const bool npy : {false, true}) {
+    CAPTURE(npy);
+    for (const std::string& name : outputs) {
+      fs::remove(dir / name);
+      fs::create_symlink(victims / name, dir / name);
+    }
+    fs::remove_all(dir / "frames");
+    fs::create_directory_symlink(victims / "frames", dir / "frames");
+    CHECK(run(npy).frames == 21);
+    for (const std::string& name : outputs) {
+      CHECK_MESSAGE(read_all(victims / name) == "victim " + name + "\n", name);
+      CHECK_FALSE(fs::is_symlink(dir / name));
+    }
+    CHECK(names_in(victims / "frames") == frames);
+    CHECK_FALSE(fs::is_symlink(dir / "frames"));
+    CHECK(fs::is_regular_file(dir / "frames" / "frame_0021.obj"));
+  }
+}
+
+TEST_CASE("outputs: --html is no link, no note that mentions the viewer, no other run's folder") {
+  const fs::path dir = fresh_dir("html-place");
+  fs::create_directories(dir);
+  const std::vector<std::string> names = {"page"};
+  const fs::path victims = make_victims("html-place", names);
+  // A temporary file's name planted as a link beside the page.
+  fs::create_symlink(victims / "page", dir / (".view.html.partial-" + std::to_string(getpid())));
+  clothlab::Scene scene = clothlab::parse_scene(kCloth, "<cloth>");
+  clothlab::RunOutputs outputs = clothlab::RunOutputs::in(dir / "run");
+  outputs.html = dir / "view.html";
+  CHECK(clothlab::run_scene(scene, outputs).frames == 21);
+  check_victims(victims, names);
+  CHECK(fs::is_regular_file(fs::symlink_status(dir / "view.html")));
+
+  // A link as the page itself: refused unless forced; forced, the link goes, not its file.
+  fs::create_symlink(victims / "page", dir / "link.html");
+  CHECK_THROWS_WITH_AS(clothlab::check_page_target(dir / "link.html", false),
+                       ((dir / "link.html").string() +
+                        " is a symbolic link; choose another --html, or add --force to replace "
+                        "the link (the file it points to is left alone)")
+                           .c_str(),
+                       OutputError);
+
+  // A user's note that names the viewer is not a page.
+  write_text(dir / "notes.html", "<!-- my notes on the clothlab viewer: it is good -->\n");
+  CHECK_THROWS_WITH_AS(clothlab::check_page_target(dir / "notes.html", false),
+                       doctest::Contains("notes.html exists and is not a clothlab viewer page"),
+                       OutputError);
+  CHECK_NOTHROW(clothlab::check_page_target(dir / "view.html", false));  // a page: replaced
+
+  // Into another run's folder while that run writes there: refused.
+  {
+    const clothlab::RunFolder other(dir / "other", false);
+    const std::string busy = "is writing into " + (dir / "other").string() +
+                             " now; wait for it to end, or choose another --html";
+    CHECK_THROWS_WITH_AS(clothlab::check_page_target(dir / "other" / "view.html", false),
+                         doctest::Contains(busy.c_str()), OutputError);
+  }
+  // And while the page may be written there, no run starts in that folder.
+  {
+    const clothlab::PageFolderLock lock =
+        clothlab::check_page_target(dir / "other" / "view.html", false);
+    CHECK_THROWS_WITH_AS(clothlab::RunFolder(dir / "other", false),
+                         doctest::Contains("is writing into"), OutputError);
+  }
+  CHECK_NOTHROW(clothlab::RunFolder(dir / "other", false));
+  check_victims(victims, names);
+}
+
+TEST_CASE("outputs: an fps so small that 1 / (fps dt) overflows writes the first and last frame") {
+  std::string text = kCloth;
+  text.replace(text.find("fps = 100"), 9, "fps = 1e-300");
+  clothlab::Scene scene = clothlab::parse_scene(text, "<cloth>");
+  const clothlab::RunReport report = clothlab::run_scene(scene, fresh_dir("tiny-fps"));
+  CHECK(report.steps == 200);
+  CHECK(report.frames == 2);
 }
