@@ -1,6 +1,7 @@
 #include "io/output.hpp"
 
 #include <cmath>
+#include <limits>
 #include <string_view>
 
 #include <fmt/format.h>
@@ -12,7 +13,8 @@
 namespace clothlab {
 
 FrameWriter::FrameWriter(const Folder& dir, bool velocities, bool springs, bool npy,
-                         Index particles) {
+                         Index particles, bool page)
+    : page_(page) {
   files_ = {dir.path() / "energy.csv"};
   energy_ = AppendFile(dir, "energy.csv");
   energy_.append("frame,t,kinetic,potential,total,px,py,pz\n");
@@ -41,16 +43,31 @@ FrameWriter::FrameWriter(const Folder& dir, bool velocities, bool springs, bool 
 
 namespace {
 
-// Frame `frame` (after step `step`) would write `what` = `value`, which is not finite.
+// Frame `frame` (after step `step`) would write `what` = `value`, which `why` says is wrong.
 [[noreturn]] void refuse_frame(const World& world, long frame, long step, std::string_view what,
-                               double value, Index particle = -1) {
-  throw SimulationError(
-      fmt::format(
-          "frame {} (after step {}, t = {:.6g} s) would write a {} of {}: a number too large "
-          "for a double, or not a number; stopped before writing it (the files hold the "
-          "frames before it)",
-          frame, step, world.t, what, value),
-      step, particle);
+                               double value, Index particle = -1,
+                               std::string_view why =
+                                   "a number too large for a double, or not "
+                                   "a number") {
+  throw SimulationError(fmt::format("frame {} (after step {}, t = {:.6g} s) would write a {} of "
+                                    "{}: {}; stopped before writing it (the files hold the "
+                                    "frames before it)",
+                                    frame, step, world.t, what, value, why),
+                        step, particle);
+}
+
+// Refuses a frame with a coordinate of `m` that a 32-bit float cannot hold: it would be inf
+// in `where` (a .npy file or the page), though a finite double in the CSV files.
+void check_float_range(const World& world, long frame, long step, const Matrix3X& m,
+                       std::string_view what, std::string_view where) {
+  constexpr double kFloatMax = std::numeric_limits<float>::max();  // 3.4e38
+  for (Index i = 0; i < m.cols(); ++i) {
+    if (m.col(i).cwiseAbs().maxCoeff() > kFloatMax) {
+      refuse_frame(
+          world, frame, step, what, m.col(i).cwiseAbs().maxCoeff(), i,
+          fmt::format("more than a 32-bit float holds ({:.3g}), which {} keeps", kFloatMax, where));
+    }
+  }
 }
 
 // One row per particle of the columns of m: "frame,t,particle,x,y,z".
@@ -118,6 +135,14 @@ void FrameWriter::write(const World& world, long frame, long step) {
   const double potential = world.potential_energy();
   const Vec3 p = world.momentum();
   check_finite_frame(world, frame, step, kinetic, potential, p);
+  if (positions_npy_) {
+    check_float_range(world, frame, step, world.particles.x, "position [m]", "positions.npy");
+  } else if (page_) {
+    check_float_range(world, frame, step, world.particles.x, "position [m]", "the page");
+  }
+  if (velocities_npy_) {
+    check_float_range(world, frame, step, world.particles.v, "velocity [m/s]", "velocities.npy");
+  }
   std::string springs;
   if (springs_.is_open()) springs = spring_rows(world, frame, step);
 

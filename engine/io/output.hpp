@@ -16,7 +16,9 @@
 // Each frame goes to each file in one piece (io/files.hpp), and a frame some file could not take
 // is cut off all of them: whenever a run stops, by the guard, a signal, a full disk or a crash,
 // every file holds the same whole frames, up to the last good one. No file ever gets an inf or a
-// NaN: a frame that would is refused before anything of it is written.
+// NaN: a frame that would is refused before anything of it is written, and so is a frame with
+// a coordinate past 3.4e38, finite as a double but inf as the 32-bit float that a .npy file and
+// the viewer page keep.
 #pragma once
 
 #include <filesystem>
@@ -33,9 +35,10 @@ class FrameWriter {
  public:
   // Opens the files in `dir`, replacing those of an earlier run; with `velocities` and
   // `springs`, velocities.csv and springs.csv as well; with `npy`, the positions (and
-  // velocities) of `particles` particles as .npy files instead of CSV.
+  // velocities) of `particles` particles as .npy files instead of CSV. With `page`, the
+  // positions also go to a viewer page as 32-bit floats (write() checks they fit).
   explicit FrameWriter(const Folder& dir, bool velocities = false, bool springs = false,
-                       bool npy = false, Index particles = 0);
+                       bool npy = false, Index particles = 0, bool page = false);
 
   // Appends frame number `frame` of the world's current state, after step `step`, to every
   // file. Throws SimulationError, before writing, if a value of the frame is not finite; throws
@@ -51,6 +54,7 @@ class FrameWriter {
   AppendFile springs_;                                            // open only when asked for
   std::optional<NpyFrameWriter> positions_npy_, velocities_npy_;  // in place of the CSV files
   std::vector<std::filesystem::path> files_;
+  bool page_ = false;
 };
 
 }  // namespace clothlab

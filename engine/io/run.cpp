@@ -94,7 +94,7 @@ RunReport run_scene(Scene& scene, const RunOutputs& outputs, const ProgressFn& p
   if (page_inside) check_page_target(outputs.html, outputs.force, /*lock_folder=*/false);
   FrameWriter writer(folder.folder(), outputs.velocities || scene.output.velocities,
                      outputs.springs || scene.output.springs, outputs.npy || scene.output.npy,
-                     scene.world.particles.size());
+                     scene.world.particles.size(), page);
   MeshExporter meshes(folder.folder(), "frames", outputs.obj, outputs.vtk);
   RunReport report;
   report.files = writer.files();

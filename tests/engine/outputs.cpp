@@ -551,3 +551,50 @@ TEST_CASE("outputs: an fps so small that 1 / (fps dt) overflows writes the first
   CHECK(report.steps == 200);
   CHECK(report.frames == 2);
 }
+
+TEST_CASE(
+    "outputs: a value past 3.4e38 stops the run before a 32-bit float file or page gets inf") {
+  // The guard's bounds, widened, let a particle fly at 1e40 m/s: x = 1e38 k m after step k, a
+  // double all along, but past the largest float (3.4e38) from step 4 on.
+  const std::string text = R"(
+[guard]
+max_speed = 1e300
+max_position = 1e300
+[[particle]]
+position = [0, 0, 0]
+velocity = [1e40, 0, 0]
+mass = 1
+[integrator]
+dt = 0.01
+duration = 0.1
+[output]
+fps = 100
+)";
+  const fs::path dir = fresh_dir("float-range");
+  clothlab::Scene scene = clothlab::parse_scene(text, "<fast>");
+  CHECK_THROWS_WITH_AS(clothlab::run_scene(scene, dir),
+                       "frame 4 (after step 4, t = 0.04 s) would write a position [m] of 4e+38: "
+                       "more than a 32-bit float holds (3.4e+38), which the page keeps; stopped "
+                       "before writing it (the files hold the frames before it)",
+                       clothlab::SimulationError);
+  std::string energy = read_all(dir / "energy.csv");
+  CHECK(std::count(energy.begin(), energy.end(), '\n') == 1 + 4);
+  CHECK(read_all(dir / "view.html").find("\"times\":[0.0,0.01,0.02,0.03]") != std::string::npos);
+
+  // velocities.npy holds the velocity of 1e40 as a float: refused at frame 0.
+  scene = clothlab::parse_scene(text + "format = \"npy\"\nvelocities = true\n", "<fast>");
+  clothlab::RunOutputs outputs = clothlab::RunOutputs::in(dir);
+  outputs.html.clear();
+  CHECK_THROWS_WITH_AS(clothlab::run_scene(scene, outputs),
+                       doctest::Contains("frame 0 (after step 0, t = 0 s) would write a velocity "
+                                         "[m/s] of 1e+40: more than a 32-bit float holds "
+                                         "(3.4e+38), which velocities.npy keeps"),
+                       clothlab::SimulationError);
+  CHECK(read_all(dir / "positions.npy").find("'shape': (0, 1, 3)") != std::string::npos);
+
+  // The CSV files alone keep doubles: the run goes to its end.
+  scene = clothlab::parse_scene(text, "<fast>");
+  CHECK(clothlab::run_scene(scene, outputs).frames == 11);
+  energy = read_all(dir / "energy.csv");
+  CHECK(std::count(energy.begin(), energy.end(), '\n') == 1 + 11);
+}
