@@ -225,11 +225,19 @@ int run(Scene& scene, const RunOutputs& outputs, bool stats) {
   }
 }
 
-// clothlab-out/<scene>/ for the reference build, clothlab-out/<scene>-student/ for the student's,
-// so that the two runs of one scene can be compared side by side.
+// <name> for the reference build, <name>-student for the student's, so that the two runs of one
+// scene can be compared side by side.
+std::string build_folder_name(const std::string& name) {
+  return name + (std::string(app::kKernels) == "student" ? "-student" : "");
+}
+
+// clothlab-out/<scene's folder>/<scene>/ (with -student for the student build): the folder's
+// name keeps apart two scenes of one file name, as lessons 12 and 13 both ship hanging-mass.toml,
+// so that a run of one never replaces the other's (clothlab-out/12-xpbd/hanging-mass/).
 fs::path default_out_dir(const std::string& scene_path) {
-  const std::string suffix = std::string(app::kKernels) == "student" ? "-student" : "";
-  return fs::path("clothlab-out") / (fs::path(scene_path).stem().string() + suffix);
+  const fs::path scene = fs::absolute(scene_path).lexically_normal();
+  return fs::path("clothlab-out") / scene.parent_path().filename() /
+         build_folder_name(scene.stem().string());
 }
 
 }  // namespace
@@ -243,8 +251,8 @@ int main(int argc, char** argv) {
   CLI::App* run_cmd = app.add_subcommand("run", "Simulate a scene and write its frames");
   run_cmd->add_option("scene", scene_path, "Scene file (.toml)")->required();
   run_cmd->add_option("--out", out_dir,
-                      "Output folder (default: clothlab-out/<scene name>, or "
-                      "clothlab-out/<scene name>-student for clothlab-student)");
+                      "Output folder (default: clothlab-out/<scene's folder>/<scene name>, or "
+                      "clothlab-out/<scene's folder>/<scene name>-student for clothlab-student)");
   std::string html;
   bool no_html = false, obj = false, vtk = false, stats = false;
   run_cmd->add_option("--html", html, "Viewer page to write (default: <output folder>/view.html)");
@@ -306,7 +314,7 @@ int main(int argc, char** argv) {
       outputs.vtk = vtk;
       outputs.velocities = velocities;
       outputs.springs = springs;
-      // A default folder, clothlab-out/<scene>, holding only what a run writes is taken as
+      // A default folder, clothlab-out/<folder>/<scene>, holding only what a run writes is taken as
       // clothlab's even without a marker: it is what a version before the marker left.
       outputs.npy = format == "npy";
       outputs.force = force || (out_dir.empty() && holds_only_run_outputs(outputs.dir));
@@ -336,7 +344,7 @@ int main(int argc, char** argv) {
     if (app.get_subcommands().empty()) {
       // No command: the demo, so that a first run shows something move.
       Scene scene = parse_scene(app::kDemoScene, app::kDemoSceneSource);
-      RunOutputs outputs = RunOutputs::in(default_out_dir("demo"));
+      RunOutputs outputs = RunOutputs::in(fs::path("clothlab-out") / build_folder_name("demo"));
       outputs.force = holds_only_run_outputs(outputs.dir);
       return run(scene, outputs, false);
     }
