@@ -32,6 +32,7 @@
 #include "app/exit_codes.hpp"
 #include "app/grade.hpp"
 #include "clothlab/core/not_implemented.hpp"
+#include "clothlab/core/stop.hpp"
 #include "clothlab/integrators/implicit_euler.hpp"
 #include "io/files.hpp"
 #include "io/run.hpp"
@@ -152,9 +153,20 @@ int run(Scene& scene, const RunOutputs& outputs, bool stats) {
   fmt::print("  {}; {}; dt = {} s for {} s ({} steps)\n", particle_count(scene),
              scene.world.effects_in_play(), scene.dt, scene.duration, scene.step_count());
   print_scene_warnings(scene);
-  const double energy_start = scene.world.kinetic_energy() + scene.world.potential_energy();
-  // The time-step advisor speaks before the run, so a user who sees it blow up knows why.
-  const TimeStepAdvice advice = advise_time_step(scene.world, scene.dt, scene.step_count());
+  // The start-up work can take long too ([gravitation]'s energy of a big cloth): a signal
+  // during it stops the run before anything is written (clothlab/core/stop.hpp).
+  double energy_start = 0.0;
+  TimeStepAdvice advice;
+  try {
+    const StopPoints points;
+    energy_start = scene.world.kinetic_energy() + scene.world.potential_energy();
+    // The time-step advisor speaks before the run, so a user who sees it blow up knows why.
+    advice = advise_time_step(scene.world, scene.dt, scene.step_count());
+  } catch (const StepAbandoned&) {
+    fmt::print(stderr, "stopped by SIG{} before the first step; nothing was written\n",
+               sigabbrev_np(StopSignals::received()));
+    return app::kExitInterrupted;
+  }
   if (!advice.warning.empty()) {
     std::fflush(stdout);
     fmt::print(stderr, "warning: {}\n", advice.warning);
@@ -209,8 +221,15 @@ int run(Scene& scene, const RunOutputs& outputs, bool stats) {
     return app::kExitBlewUp;
   } catch (const RunStopped& stop) {
     end_bar();
-    fmt::print(stderr, "{} (t = {:.6g} s): {} frames, the last at that step, are in {}\n",
-               stop.what(), scene.world.t, stop.frames(), frames_are_in());
+    if (stop.abandoned() < 0) {
+      fmt::print(stderr, "{} (t = {:.6g} s): {} frames, the last at that step, are in {}\n",
+                 stop.what(), scene.world.t, stop.frames(), frames_are_in());
+    } else if (stop.frames() == 0) {
+      fmt::print(stderr, "{}; no frame was written\n", stop.what());
+    } else {
+      fmt::print(stderr, "{}: {} frames, the last after step {}, are in {}\n", stop.what(),
+                 stop.frames(), stop.step(), frames_are_in());
+    }
     return app::kExitInterrupted;
   } catch (const OutputError& error) {
     end_bar();
@@ -305,6 +324,8 @@ int main(int argc, char** argv) {
 
   try {
     if (*run_cmd) {
+      // Ctrl-C and TERM stop the run cleanly from here on, the start-up work included.
+      const StopSignals stop_signals;
       Scene scene = load_scene_file(scene_path);
       RunOutputs outputs =
           RunOutputs::in(out_dir.empty() ? default_out_dir(scene_path) : fs::path(out_dir));

@@ -1,5 +1,7 @@
 #include "io/run.hpp"
 
+#include <unistd.h>
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -9,6 +11,7 @@
 
 #include <fmt/format.h>
 
+#include "clothlab/core/stop.hpp"
 #include "io/mesh_export.hpp"
 #include "io/output.hpp"
 #include "io/run_folder.hpp"
@@ -18,10 +21,13 @@ namespace clothlab {
 
 namespace {
 
-volatile std::sig_atomic_t g_stop_signal = 0;
-
+// Says at once that the run heard the signal, with write(2), which a handler may call.
 extern "C" void on_stop_signal(int signal) {
-  g_stop_signal = signal;
+  ask_to_stop(signal);
+  static constexpr char kSaid[] =
+      "\nstopping after this step (a long step is given up part way); a second signal ends the "
+      "run at once\n";
+  [[maybe_unused]] const ssize_t n = ::write(STDERR_FILENO, kSaid, sizeof kSaid - 1);
 }
 
 struct sigaction g_old_int {};
@@ -44,7 +50,7 @@ std::string signal_name(int signal) {
 
 StopSignals::StopSignals() {
   if (g_stop_signals_alive++ > 0) return;
-  g_stop_signal = 0;
+  ask_to_stop(0);
   struct sigaction sa {};
   sa.sa_handler = on_stop_signal;
   sigemptyset(&sa.sa_mask);
@@ -65,18 +71,24 @@ StopSignals::~StopSignals() {
   sigaction(SIGINT, &g_old_int, nullptr);
   sigaction(SIGTERM, &g_old_term, nullptr);
   sigaction(SIGXFSZ, &g_old_xfsz, nullptr);
-  g_stop_signal = 0;
+  ask_to_stop(0);
 }
 
 int StopSignals::received() {
-  return g_stop_signal;
+  return stop_asked();
 }
 
-RunStopped::RunStopped(int signal, long step, long frames)
-    : std::runtime_error(fmt::format("stopped by {} after step {}", signal_name(signal), step)),
+RunStopped::RunStopped(int signal, long step, long frames, long abandoned)
+    : std::runtime_error(
+          abandoned > 0 ? fmt::format("stopped by {} during step {}, given up part way",
+                                      signal_name(signal), abandoned)
+          : abandoned == 0
+              ? fmt::format("stopped by {} before the first frame", signal_name(signal))
+              : fmt::format("stopped by {} after step {}", signal_name(signal), step)),
       signal_(signal),
       step_(step),
-      frames_(frames) {}
+      frames_(frames),
+      abandoned_(abandoned) {}
 
 RunReport run_scene(Scene& scene, const RunOutputs& outputs, const ProgressFn& progress) {
   StopSignals stop_signals;
@@ -113,11 +125,13 @@ RunReport run_scene(Scene& scene, const RunOutputs& outputs, const ProgressFn& p
 
   World& world = scene.world;
   long step = 0;
+  long frame_step = 0;  // the step of the last frame written
   const auto write_frame = [&] {
     writer.write(world, report.frames, step);
     meshes.write(world, report.frames + 1);  // mesh files count from 1: frame_0001
     if (page) viewer.offer(world);
     ++report.frames;
+    frame_step = step;
   };
   // The page is rewritten now and then during a long run, so that it is there whatever stops
   // the run; at most every half minute, and at most a twentieth of the time the run takes.
@@ -148,9 +162,21 @@ RunReport run_scene(Scene& scene, const RunOutputs& outputs, const ProgressFn& p
 
   const auto start = Clock::now();
   try {
-    write_frame();
+    // A stop asked for during a long step (or the first frame's energy) gives it up part way
+    // (clothlab/core/stop.hpp): the files keep the frames before it.
+    try {
+      const StopPoints points;
+      write_frame();
+    } catch (const StepAbandoned&) {
+      throw RunStopped(StopSignals::received(), 0, 0, 0);
+    }
     for (step = 1; step <= total; ++step) {
-      world.step(scene.dt);
+      try {
+        const StopPoints points;
+        world.step(scene.dt);
+      } catch (const StepAbandoned&) {
+        throw RunStopped(StopSignals::received(), frame_step, report.frames, step);
+      }
       const bool frame_due = step % steps_per_frame == 0 || step == total;
       if (frame_due) write_frame();
       if (progress) progress(step, total);

@@ -10,11 +10,14 @@
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <memory>
 #include <sstream>
 #include <string>
 #include <vector>
 
+#include "clothlab/core/effect.hpp"
 #include "clothlab/core/guard.hpp"
+#include "clothlab/core/stop.hpp"
 #include "io/files.hpp"
 #include "io/npy.hpp"
 #include "io/run.hpp"
@@ -597,4 +600,69 @@ fps = 100
   CHECK(clothlab::run_scene(scene, outputs).frames == 11);
   energy = read_all(dir / "energy.csv");
   CHECK(std::count(energy.begin(), energy.end(), '\n') == 1 + 11);
+}
+
+namespace {
+
+// A force of nothing that, at its `at`-th evaluation, asks the run to stop as a TERM would: a
+// signal that arrives in the middle of a step, at a known moment.
+class StopAtEvaluation : public clothlab::ForceEffect {
+ public:
+  explicit StopAtEvaluation(long at) : at_(at) {}
+  std::string_view name() const override { return "stop-at-evaluation"; }
+  void add_forces(const clothlab::Particles&, const clothlab::Matrix3X&, const clothlab::Matrix3X&,
+                  clothlab::Matrix3X&) const override {
+    if (++evaluations_ == at_) std::raise(SIGTERM);
+  }
+  mutable long evaluations_ = 0;
+
+ private:
+  long at_;
+};
+
+}  // namespace
+
+TEST_CASE("outputs: a TERM during a step of many substeps gives it up, not minutes later") {
+  // XPBD with 2000 substeps a step, one sum of the external forces each: the TERM comes in the
+  // 5th substep of step 3 (evaluation 2 * 2000 + 5), and the run ends in that substep.
+  std::string text = kCloth;
+  text.replace(text.find("[integrator]"), 12,
+               "[integrator]\nmethod = \"xpbd\"\nsubsteps = 2000\niterations = 1");
+  clothlab::Scene scene = clothlab::parse_scene(text, "<cloth>");
+  auto stopper = std::make_unique<StopAtEvaluation>(2 * 2000 + 5);
+  const StopAtEvaluation& counter = *stopper;
+  scene.world.force_effects.push_back(std::move(stopper));
+  const fs::path dir = fresh_dir("term-substeps");
+  try {
+    clothlab::run_scene(scene, dir);
+    FAIL("the run was not stopped");
+  } catch (const clothlab::RunStopped& stop) {
+    CHECK(std::string(stop.what()) == "stopped by SIGTERM during step 3, given up part way");
+    CHECK(stop.abandoned() == 3);
+    CHECK(stop.step() == 0);  // the last frame written: frame 0 (frames are every 10 steps)
+    CHECK(stop.frames() == 1);
+  }
+  CHECK(counter.evaluations_ == 2 * 2000 + 5);  // not one substep more
+  const std::string energy = read_all(dir / "energy.csv");
+  CHECK(std::count(energy.begin(), energy.end(), '\n') == 1 + 1);
+  CHECK(fs::exists(dir / "view.html"));
+  CHECK(clothlab::StopSignals::received() == 0);
+}
+
+TEST_CASE("outputs: the long loops give up their work on a stop only where a run asked them to") {
+  // [gravitation]'s energy, n^2 / 2 pairs, and local/global and strain limiting's iterations.
+  std::string text = kCloth;
+  text += "[gravitation]\n[strain_limit]\nmax_strain = 0.1\n";
+  clothlab::Scene scene = clothlab::parse_scene(text, "<cloth>");
+  const double energy = scene.world.potential_energy();
+  clothlab::ask_to_stop(SIGTERM);
+  CHECK(scene.world.potential_energy() == energy);  // no StopPoints: a test, the game loop
+  {
+    const clothlab::StopPoints points;
+    CHECK_THROWS_AS(scene.world.potential_energy(), clothlab::StepAbandoned);
+    CHECK_THROWS_AS(scene.world.step(0.001), clothlab::StepAbandoned);
+  }
+  clothlab::ask_to_stop(0);
+  const clothlab::StopPoints points;
+  CHECK(scene.world.potential_energy() == energy);
 }
