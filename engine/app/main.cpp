@@ -3,6 +3,7 @@
 //   clothlab                          run the built-in demo scene
 //   clothlab run SCENE.toml [--out D] simulate a scene and write its frames (--threads N)
 //   clothlab validate SCENE.toml      check a scene without running it
+//   clothlab repair DIR               cut a killed run's files back to their common frames
 //   clothlab grade [...]              build and grade the exercises (see app/grade/)
 //   clothlab watch [exNN[.k]]         grade again on every save of an exercise file
 //   clothlab bench boundary           measure what the exercise boundary costs
@@ -35,6 +36,7 @@
 #include "clothlab/core/stop.hpp"
 #include "clothlab/integrators/implicit_euler.hpp"
 #include "io/files.hpp"
+#include "io/output.hpp"
 #include "io/run.hpp"
 #include "io/run_folder.hpp"
 #include "scene/scene.hpp"
@@ -311,6 +313,11 @@ int main(int argc, char** argv) {
   CLI::App* validate_cmd = app.add_subcommand("validate", "Check a scene without running it");
   validate_cmd->add_option("scene", validate_path, "Scene file (.toml)")->required();
 
+  std::string repair_dir;
+  CLI::App* repair_cmd = app.add_subcommand(
+      "repair", "Cut a killed run's files back to the frames all of them hold (README: a SIGKILL)");
+  repair_cmd->add_option("folder", repair_dir, "The run's output folder")->required();
+
   app::add_grade_command(app);
   app::add_watch_command(app);
   app::add_bench_command(app);
@@ -360,6 +367,12 @@ int main(int argc, char** argv) {
         std::fflush(stdout);
         fmt::print(stderr, "warning: {}\n", advice.warning);
       }
+      return 0;
+    }
+    if (*repair_cmd) {
+      const long frames = cut_to_common_frames(repair_dir);
+      fmt::print("{}: every file holds frames 0 to {} ({} frames)\n", repair_dir, frames - 1,
+                 frames);
       return 0;
     }
     if (app.get_subcommands().empty()) {

@@ -57,4 +57,11 @@ class FrameWriter {
   bool page_ = false;
 };
 
+// After a run that was killed (SIGKILL, a crash, a power cut: no chance to cut anything back),
+// the files may end on different frames, one of them in a cut line: each frame goes to the other
+// files first and to energy.csv last, so energy.csv's whole rows are the frames every file
+// holds. Cuts every file in `dir` back to those frames (and a .npy's count with them); returns
+// how many. Throws OutputError naming a file it cannot read or cut. `clothlab repair DIR`.
+long cut_to_common_frames(const std::filesystem::path& dir);
+
 }  // namespace clothlab

@@ -20,6 +20,7 @@
 #include "clothlab/core/stop.hpp"
 #include "io/files.hpp"
 #include "io/npy.hpp"
+#include "io/output.hpp"
 #include "io/run.hpp"
 #include "io/run_folder.hpp"
 #include "scene/scene.hpp"
@@ -665,4 +666,46 @@ TEST_CASE("outputs: the long loops give up their work on a stop only where a run
   clothlab::ask_to_stop(0);
   const clothlab::StopPoints points;
   CHECK(scene.world.potential_energy() == energy);
+}
+
+TEST_CASE("outputs: after a SIGKILL every file is cut back to the frames all of them hold") {
+  const fs::path dir = fresh_dir("killed");
+  for (const bool npy : {false, true}) {
+    CAPTURE(npy);
+    std::string text = kCloth;
+    text += npy ? "velocities = true\nformat = \"npy\"\n" : "velocities = true\nsprings = true\n";
+    clothlab::Scene scene = clothlab::parse_scene(text, "<cloth>");
+    clothlab::run_scene(scene, dir);
+    const std::vector<std::string> names =
+        npy ? std::vector<std::string>{"energy.csv", "positions.npy", "velocities.npy"}
+            : std::vector<std::string>{"energy.csv", "positions.csv", "velocities.csv",
+                                       "springs.csv"};
+    std::vector<std::string> whole;
+    for (const std::string& name : names)
+      whole.push_back(read_all(dir / name));
+    // A kill in the middle of frame 21: positions took it whole, velocities a part of it, and
+    // energy.csv a cut line (or, for .npy, the frame's bytes and the count that takes it in).
+    const auto append = [&](const std::string& name, const std::string& more) {
+      std::ofstream(dir / name, std::ios::app | std::ios::binary) << more;
+    };
+    if (npy) {
+      std::string bytes = read_all(dir / "positions.npy");
+      const std::string shape = "'shape': (21, 400, 3)";
+      bytes.replace(bytes.find(shape), shape.size(), "'shape': (22, 400, 3)");
+      write_text(dir / "positions.npy", bytes + std::string(400 * 12, 'x'));
+      append("velocities.npy", std::string(100, 'x'));
+    } else {
+      std::string frame;
+      for (int i = 0; i < 400; ++i)
+        frame += "21,0.21," + std::to_string(i) + ",1,2,3\n";
+      append("positions.csv", frame);
+      append("velocities.csv", frame.substr(0, 1000));
+      append("springs.csv", "21,0.21,springs,0,0,1,0.0");
+    }
+    append("energy.csv", "21,0.2");
+    CHECK(clothlab::cut_to_common_frames(dir) == 21);
+    for (size_t k = 0; k < names.size(); ++k)
+      CHECK_MESSAGE(read_all(dir / names[k]) == whole[k], names[k]);
+    CHECK(clothlab::cut_to_common_frames(dir) == 21);  // a second time: nothing to do
+  }
 }
