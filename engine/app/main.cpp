@@ -25,6 +25,7 @@
 #include <fmt/format.h>
 #include <CLI/CLI.hpp>
 
+#include "analysis/run_cost.hpp"
 #include "analysis/stability.hpp"
 #include "app/bench.hpp"
 #include "app/build_info.hpp"
@@ -137,11 +138,14 @@ void warn_unconverged(const World& world) {
              s.unconverged, s.solves, implicit->max_iterations, s.worst_error, implicit->tolerance);
 }
 
-// The scene reader's warnings: inputs that run but are likely mistakes, each with FILE:LINE:COL.
-void print_scene_warnings(const Scene& scene) {
+// The scene reader's warnings: inputs that run but are likely mistakes, each with FILE:LINE:COL;
+// then what the run will cost, where a part of it will take long or its files be big.
+void print_scene_warnings(const Scene& scene, bool velocities, bool springs, bool npy) {
   std::fflush(stdout);  // after what was printed before them
   for (const SceneWarning& warning : scene.warnings)
     fmt::print(stderr, "warning: {}\n", warning.text());
+  for (const std::string& cost : run_cost_warnings(scene, velocities, springs, npy))
+    fmt::print(stderr, "warning: {}\n", cost);
 }
 
 int run(Scene& scene, const RunOutputs& outputs, bool stats) {
@@ -154,7 +158,8 @@ int run(Scene& scene, const RunOutputs& outputs, bool stats) {
              scene.title.empty() ? "" : " - " + scene.title);
   fmt::print("  {}; {}; dt = {} s for {} s ({} steps)\n", particle_count(scene),
              scene.world.effects_in_play(), scene.dt, scene.duration, scene.step_count());
-  print_scene_warnings(scene);
+  print_scene_warnings(scene, outputs.velocities || scene.output.velocities,
+                       outputs.springs || scene.output.springs, outputs.npy || scene.output.npy);
   // The start-up work can take long too ([gravitation]'s energy of a big cloth): a signal
   // during it stops the run before anything is written (clothlab/core/stop.hpp).
   double energy_start = 0.0;
@@ -356,7 +361,7 @@ int main(int argc, char** argv) {
       fmt::print("{}: ok: {}; {}; dt = {} s for {} s ({} steps)\n", validate_path,
                  particle_count(scene), scene.world.effects_in_play(), scene.dt, scene.duration,
                  scene.step_count());
-      print_scene_warnings(scene);
+      print_scene_warnings(scene, scene.output.velocities, scene.output.springs, scene.output.npy);
       const TimeStepAdvice advice = advise_time_step(scene.world, scene.dt, scene.step_count());
       if (advice.bounds.omega_max > 0.0) {
         fmt::print("  stiffest mode: w <= {:.4g} rad/s; stable time step for {}: {}\n",
