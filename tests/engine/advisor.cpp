@@ -527,7 +527,7 @@ clothlab::Scene cost_scene(int rows, const std::string& integrator, const std::s
 }  // namespace
 
 TEST_CASE(
-    "advisor: a run that cannot finish, or whose files will not fit, is told before it starts") {
+    "advisor: a run that cannot finish or whose files will not fit is told before it starts") {
   // 100 x 100: 39402 springs. XPBD with 1000 substeps and 10 iterations projects 3.9e8
   // constraints a step, about 20 s at 51 ns each: hours for 1000 steps.
   const std::string xpbd =

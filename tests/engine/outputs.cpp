@@ -389,7 +389,7 @@ void check_victims(const fs::path& victims, const std::vector<std::string>& name
 
 }  // namespace
 
-TEST_CASE("outputs: every writer replaces a symbolic link in its place, not the file it names") {
+TEST_CASE("outputs: every writer replaces a symbolic link in its place and not the file it names") {
   const fs::path dir = fresh_dir("writer-links");
   fs::create_directories(dir);
   const std::vector<std::string> names = {"append", "npy", "partial", "replace"};
@@ -414,7 +414,7 @@ TEST_CASE("outputs: every writer replaces a symbolic link in its place, not the 
   CHECK(names_in(dir) == std::vector<std::string>{"page.html", "rows.csv", "x.npy"});
 }
 
-TEST_CASE("outputs: a marker that is a link or has a second name is refused, its file untouched") {
+TEST_CASE("outputs: a marker that is a link or has a second name is refused and its file kept") {
   const std::vector<std::string> names = {"marker"};
   const fs::path victims = make_victims("marker-link", names);
   const fs::path dir = fresh_dir("marker-link");
@@ -455,7 +455,7 @@ TEST_CASE("outputs: a marker that is a link or has a second name is refused, its
   CHECK(fs::is_empty(victims / "folder"));
 }
 
-TEST_CASE("outputs: links in a run folder are removed as names; what they point to is kept") {
+TEST_CASE("outputs: links in a run folder are removed as names and what they point to is kept") {
   const fs::path dir = fresh_dir("folder-links");
   const auto run = [&](bool npy) {
     std::string text = kCloth;
@@ -498,7 +498,8 @@ TEST_CASE("outputs: links in a run folder are removed as names; what they point 
   }
 }
 
-TEST_CASE("outputs: --html is no link, no note that mentions the viewer, no other run's folder") {
+TEST_CASE(
+    "outputs: --html is no link nor a note that mentions the viewer nor another run's folder") {
   const fs::path dir = fresh_dir("html-place");
   fs::create_directories(dir);
   const std::vector<std::string> names = {"page"};
@@ -623,7 +624,7 @@ class StopAtEvaluation : public clothlab::ForceEffect {
 
 }  // namespace
 
-TEST_CASE("outputs: a TERM during a step of many substeps gives it up, not minutes later") {
+TEST_CASE("outputs: a TERM during a step of many substeps gives it up at once") {
   // XPBD with 2000 substeps a step, one sum of the external forces each: the TERM comes in the
   // 5th substep of step 3 (evaluation 2 * 2000 + 5), and the run ends in that substep.
   std::string text = kCloth;
