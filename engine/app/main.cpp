@@ -3,6 +3,7 @@
 //   clothlab                          run the built-in demo scene
 //   clothlab run SCENE.toml [--out D] simulate a scene and write its frames (--threads N)
 //   clothlab validate SCENE.toml      check a scene without running it
+//   clothlab repair DIR               cut a killed run's files back to their common frames
 //   clothlab grade [...]              build and grade the exercises (see app/grade/)
 //   clothlab watch [exNN[.k]]         grade again on every save of an exercise file
 //   clothlab bench boundary           measure what the exercise boundary costs
@@ -24,6 +25,7 @@
 #include <fmt/format.h>
 #include <CLI/CLI.hpp>
 
+#include "analysis/run_cost.hpp"
 #include "analysis/stability.hpp"
 #include "app/bench.hpp"
 #include "app/build_info.hpp"
@@ -32,8 +34,10 @@
 #include "app/exit_codes.hpp"
 #include "app/grade.hpp"
 #include "clothlab/core/not_implemented.hpp"
+#include "clothlab/core/stop.hpp"
 #include "clothlab/integrators/implicit_euler.hpp"
 #include "io/files.hpp"
+#include "io/output.hpp"
 #include "io/run.hpp"
 #include "io/run_folder.hpp"
 #include "scene/scene.hpp"
@@ -134,11 +138,14 @@ void warn_unconverged(const World& world) {
              s.unconverged, s.solves, implicit->max_iterations, s.worst_error, implicit->tolerance);
 }
 
-// The scene reader's warnings: inputs that run but are likely mistakes, each with FILE:LINE:COL.
-void print_scene_warnings(const Scene& scene) {
+// The scene reader's warnings: inputs that run but are likely mistakes, each with FILE:LINE:COL;
+// then what the run will cost, where a part of it will take long or its files be big.
+void print_scene_warnings(const Scene& scene, bool velocities, bool springs, bool npy) {
   std::fflush(stdout);  // after what was printed before them
   for (const SceneWarning& warning : scene.warnings)
     fmt::print(stderr, "warning: {}\n", warning.text());
+  for (const std::string& cost : run_cost_warnings(scene, velocities, springs, npy))
+    fmt::print(stderr, "warning: {}\n", cost);
 }
 
 int run(Scene& scene, const RunOutputs& outputs, bool stats) {
@@ -151,10 +158,22 @@ int run(Scene& scene, const RunOutputs& outputs, bool stats) {
              scene.title.empty() ? "" : " - " + scene.title);
   fmt::print("  {}; {}; dt = {} s for {} s ({} steps)\n", particle_count(scene),
              scene.world.effects_in_play(), scene.dt, scene.duration, scene.step_count());
-  print_scene_warnings(scene);
-  const double energy_start = scene.world.kinetic_energy() + scene.world.potential_energy();
-  // The time-step advisor speaks before the run, so a user who sees it blow up knows why.
-  const TimeStepAdvice advice = advise_time_step(scene.world, scene.dt, scene.step_count());
+  print_scene_warnings(scene, outputs.velocities || scene.output.velocities,
+                       outputs.springs || scene.output.springs, outputs.npy || scene.output.npy);
+  // The start-up work can take long too ([gravitation]'s energy of a big cloth): a signal
+  // during it stops the run before anything is written (clothlab/core/stop.hpp).
+  double energy_start = 0.0;
+  TimeStepAdvice advice;
+  try {
+    const StopPoints points;
+    energy_start = scene.world.kinetic_energy() + scene.world.potential_energy();
+    // The time-step advisor speaks before the run, so a user who sees it blow up knows why.
+    advice = advise_time_step(scene.world, scene.dt, scene.step_count());
+  } catch (const StepAbandoned&) {
+    fmt::print(stderr, "stopped by SIG{} before the first step; nothing was written\n",
+               sigabbrev_np(StopSignals::received()));
+    return app::kExitInterrupted;
+  }
   if (!advice.warning.empty()) {
     std::fflush(stdout);
     fmt::print(stderr, "warning: {}\n", advice.warning);
@@ -209,8 +228,15 @@ int run(Scene& scene, const RunOutputs& outputs, bool stats) {
     return app::kExitBlewUp;
   } catch (const RunStopped& stop) {
     end_bar();
-    fmt::print(stderr, "{} (t = {:.6g} s): {} frames, the last at that step, are in {}\n",
-               stop.what(), scene.world.t, stop.frames(), frames_are_in());
+    if (stop.abandoned() < 0) {
+      fmt::print(stderr, "{} (t = {:.6g} s): {} frames, the last at that step, are in {}\n",
+                 stop.what(), scene.world.t, stop.frames(), frames_are_in());
+    } else if (stop.frames() == 0) {
+      fmt::print(stderr, "{}; no frame was written\n", stop.what());
+    } else {
+      fmt::print(stderr, "{}: {} frames, the last after step {}, are in {}\n", stop.what(),
+                 stop.frames(), stop.step(), frames_are_in());
+    }
     return app::kExitInterrupted;
   } catch (const OutputError& error) {
     end_bar();
@@ -225,11 +251,19 @@ int run(Scene& scene, const RunOutputs& outputs, bool stats) {
   }
 }
 
-// clothlab-out/<scene>/ for the reference build, clothlab-out/<scene>-student/ for the student's,
-// so that the two runs of one scene can be compared side by side.
+// <name> for the reference build, <name>-student for the student's, so that the two runs of one
+// scene can be compared side by side.
+std::string build_folder_name(const std::string& name) {
+  return name + (std::string(app::kKernels) == "student" ? "-student" : "");
+}
+
+// clothlab-out/<scene's folder>/<scene>/ (with -student for the student build): the folder's
+// name keeps apart two scenes of one file name, as lessons 12 and 13 both ship hanging-mass.toml,
+// so that a run of one never replaces the other's (clothlab-out/12-xpbd/hanging-mass/).
 fs::path default_out_dir(const std::string& scene_path) {
-  const std::string suffix = std::string(app::kKernels) == "student" ? "-student" : "";
-  return fs::path("clothlab-out") / (fs::path(scene_path).stem().string() + suffix);
+  const fs::path scene = fs::absolute(scene_path).lexically_normal();
+  return fs::path("clothlab-out") / scene.parent_path().filename() /
+         build_folder_name(scene.stem().string());
 }
 
 }  // namespace
@@ -243,8 +277,8 @@ int main(int argc, char** argv) {
   CLI::App* run_cmd = app.add_subcommand("run", "Simulate a scene and write its frames");
   run_cmd->add_option("scene", scene_path, "Scene file (.toml)")->required();
   run_cmd->add_option("--out", out_dir,
-                      "Output folder (default: clothlab-out/<scene name>, or "
-                      "clothlab-out/<scene name>-student for clothlab-student)");
+                      "Output folder (default: clothlab-out/<scene's folder>/<scene name>, or "
+                      "clothlab-out/<scene's folder>/<scene name>-student for clothlab-student)");
   std::string html;
   bool no_html = false, obj = false, vtk = false, stats = false;
   run_cmd->add_option("--html", html, "Viewer page to write (default: <output folder>/view.html)");
@@ -284,6 +318,11 @@ int main(int argc, char** argv) {
   CLI::App* validate_cmd = app.add_subcommand("validate", "Check a scene without running it");
   validate_cmd->add_option("scene", validate_path, "Scene file (.toml)")->required();
 
+  std::string repair_dir;
+  CLI::App* repair_cmd = app.add_subcommand(
+      "repair", "Cut a killed run's files back to the frames all of them hold (README: a SIGKILL)");
+  repair_cmd->add_option("folder", repair_dir, "The run's output folder")->required();
+
   app::add_grade_command(app);
   app::add_watch_command(app);
   app::add_bench_command(app);
@@ -297,6 +336,8 @@ int main(int argc, char** argv) {
 
   try {
     if (*run_cmd) {
+      // Ctrl-C and TERM stop the run cleanly from here on, the start-up work included.
+      const StopSignals stop_signals;
       Scene scene = load_scene_file(scene_path);
       RunOutputs outputs =
           RunOutputs::in(out_dir.empty() ? default_out_dir(scene_path) : fs::path(out_dir));
@@ -306,7 +347,7 @@ int main(int argc, char** argv) {
       outputs.vtk = vtk;
       outputs.velocities = velocities;
       outputs.springs = springs;
-      // A default folder, clothlab-out/<scene>, holding only what a run writes is taken as
+      // A default folder, clothlab-out/<folder>/<scene>, holding only what a run writes is taken as
       // clothlab's even without a marker: it is what a version before the marker left.
       outputs.npy = format == "npy";
       outputs.force = force || (out_dir.empty() && holds_only_run_outputs(outputs.dir));
@@ -320,7 +361,7 @@ int main(int argc, char** argv) {
       fmt::print("{}: ok: {}; {}; dt = {} s for {} s ({} steps)\n", validate_path,
                  particle_count(scene), scene.world.effects_in_play(), scene.dt, scene.duration,
                  scene.step_count());
-      print_scene_warnings(scene);
+      print_scene_warnings(scene, scene.output.velocities, scene.output.springs, scene.output.npy);
       const TimeStepAdvice advice = advise_time_step(scene.world, scene.dt, scene.step_count());
       if (advice.bounds.omega_max > 0.0) {
         fmt::print("  stiffest mode: w <= {:.4g} rad/s; stable time step for {}: {}\n",
@@ -333,10 +374,16 @@ int main(int argc, char** argv) {
       }
       return 0;
     }
+    if (*repair_cmd) {
+      const long frames = cut_to_common_frames(repair_dir);
+      fmt::print("{}: every file holds frames 0 to {} ({} frames)\n", repair_dir, frames - 1,
+                 frames);
+      return 0;
+    }
     if (app.get_subcommands().empty()) {
       // No command: the demo, so that a first run shows something move.
       Scene scene = parse_scene(app::kDemoScene, app::kDemoSceneSource);
-      RunOutputs outputs = RunOutputs::in(default_out_dir("demo"));
+      RunOutputs outputs = RunOutputs::in(fs::path("clothlab-out") / build_folder_name("demo"));
       outputs.force = holds_only_run_outputs(outputs.dir);
       return run(scene, outputs, false);
     }

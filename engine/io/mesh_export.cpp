@@ -50,9 +50,9 @@ void vertex_normals(const Matrix3X& x, const std::vector<Triangle>& triangles, M
   }
 }
 
-MeshExporter::MeshExporter(const std::filesystem::path& dir, bool obj, bool vtk)
-    : dir_(dir), obj_(obj), vtk_(vtk) {
-  if (obj_ || vtk_) std::filesystem::create_directories(dir_);
+MeshExporter::MeshExporter(const Folder& parent, const std::string& name, bool obj, bool vtk)
+    : obj_(obj), vtk_(vtk) {
+  if (obj_ || vtk_) dir_.emplace(parent, name);
 }
 
 void MeshExporter::write(const World& world, long frame) {
@@ -79,7 +79,7 @@ void MeshExporter::write(const World& world, long frame) {
       for (const SpringView& s : springs)
         fmt::format_to(out, "l {} {}\n", s.i + 1, s.j + 1);
     }
-    write_whole_file(dir_ / (stem + ".obj"), std::string_view(text.data(), text.size()));
+    write_whole_file(*dir_, stem + ".obj", std::string_view(text.data(), text.size()));
   }
   if (vtk_) {
     const std::string name = stem + ".vtk";
@@ -109,7 +109,7 @@ void MeshExporter::write(const World& world, long frame) {
     fmt::format_to(out, "POINT_DATA {}\nVECTORS velocity double\n", x.cols());
     for (Index i = 0; i < v.cols(); ++i)
       fmt::format_to(out, "{} {} {}\n", v(0, i), v(1, i), v(2, i));
-    write_whole_file(dir_ / name, std::string_view(text.data(), text.size()));
+    write_whole_file(*dir_, name, std::string_view(text.data(), text.size()));
     vtk_files_.emplace_back(name, world.t);
     finish();  // the index names every whole frame at every moment
   }
@@ -123,7 +123,7 @@ void MeshExporter::finish() const {
                    vtk_files_[k].first, vtk_files_[k].second, k + 1 < vtk_files_.size() ? "," : "");
   }
   text += "  ]\n}\n";
-  write_whole_file(dir_ / "frames.vtk.series", text);
+  write_whole_file(*dir_, "frames.vtk.series", text);
 }
 
 }  // namespace clothlab

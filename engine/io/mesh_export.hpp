@@ -9,17 +9,20 @@
 #pragma once
 
 #include <filesystem>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "clothlab/core/world.hpp"
+#include "io/files.hpp"
 
 namespace clothlab {
 
 class MeshExporter {
  public:
-  // Writes into `dir` (created if needed) the formats asked for.
-  MeshExporter(const std::filesystem::path& dir, bool obj, bool vtk);
+  // Writes the formats asked for into the folder `name` in `parent` (made if needed, and never
+  // a symbolic link: io/files.hpp).
+  MeshExporter(const Folder& parent, const std::string& name, bool obj, bool vtk);
 
   // Writes the world's current state as frame number `frame` (numbered from 1 in file names).
   void write(const World& world, long frame);
@@ -28,7 +31,7 @@ class MeshExporter {
   void finish() const;
 
  private:
-  std::filesystem::path dir_;
+  std::optional<Folder> dir_;  // only when a format is asked for
   bool obj_, vtk_;
   std::vector<std::pair<std::string, double>> vtk_files_;  // name and time [s]
 };

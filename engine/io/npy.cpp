@@ -54,13 +54,11 @@ std::string NpyFrameWriter::header(long frames, Index particles) {
   return out + dict;
 }
 
-NpyFrameWriter::NpyFrameWriter(std::filesystem::path path, Index particles)
-    : path_(std::move(path)), particles_(particles) {
-  fd_ = ::open(path_.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0666);
-  if (fd_ < 0) {
-    throw std::runtime_error(
-        fmt::format("cannot write {}: {}", path_.string(), std::strerror(errno)));
-  }
+NpyFrameWriter::NpyFrameWriter(const std::filesystem::path& path, Index particles)
+    : NpyFrameWriter(Folder::holding(path), path.filename().string(), particles) {}
+
+NpyFrameWriter::NpyFrameWriter(const Folder& folder, const std::string& name, Index particles)
+    : path_(folder.path() / name), fd_(open_new_file(folder, name)), particles_(particles) {
   const std::string head = header(0, particles_);
   if (const int error = write_all_at(fd_, head.data(), head.size(), 0)) {
     ::close(fd_);

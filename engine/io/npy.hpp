@@ -18,13 +18,17 @@
 #include <string>
 
 #include "clothlab/core/types.hpp"
+#include "io/files.hpp"
 
 namespace clothlab {
 
 class NpyFrameWriter {
  public:
-  // Creates `path`, or replaces what was there, as a file of no frames of `particles` particles.
-  NpyFrameWriter(std::filesystem::path path, Index particles);
+  // Creates `name` in `folder` as a new file of no frames of `particles` particles, replacing
+  // what was there under that name (open_new_file in io/files.hpp: never through a link).
+  NpyFrameWriter(const Folder& folder, const std::string& name, Index particles);
+  // The same for `path` in the folder that holds it.
+  NpyFrameWriter(const std::filesystem::path& path, Index particles);
   ~NpyFrameWriter();
   NpyFrameWriter(NpyFrameWriter&& other) noexcept;
   NpyFrameWriter& operator=(NpyFrameWriter&& other) noexcept;

@@ -16,7 +16,9 @@
 // Each frame goes to each file in one piece (io/files.hpp), and a frame some file could not take
 // is cut off all of them: whenever a run stops, by the guard, a signal, a full disk or a crash,
 // every file holds the same whole frames, up to the last good one. No file ever gets an inf or a
-// NaN: a frame that would is refused before anything of it is written.
+// NaN: a frame that would is refused before anything of it is written, and so is a frame with
+// a coordinate past 3.4e38, finite as a double but inf as the 32-bit float that a .npy file and
+// the viewer page keep.
 #pragma once
 
 #include <filesystem>
@@ -31,11 +33,12 @@ namespace clothlab {
 
 class FrameWriter {
  public:
-  // Opens the files in `dir` (which must exist), replacing those of an earlier run; with
-  // `velocities` and `springs`, velocities.csv and springs.csv as well; with `npy`, the
-  // positions (and velocities) of `particles` particles as .npy files instead of CSV.
-  explicit FrameWriter(const std::filesystem::path& dir, bool velocities = false,
-                       bool springs = false, bool npy = false, Index particles = 0);
+  // Opens the files in `dir`, replacing those of an earlier run; with `velocities` and
+  // `springs`, velocities.csv and springs.csv as well; with `npy`, the positions (and
+  // velocities) of `particles` particles as .npy files instead of CSV. With `page`, the
+  // positions also go to a viewer page as 32-bit floats (write() checks they fit).
+  explicit FrameWriter(const Folder& dir, bool velocities = false, bool springs = false,
+                       bool npy = false, Index particles = 0, bool page = false);
 
   // Appends frame number `frame` of the world's current state, after step `step`, to every
   // file. Throws SimulationError, before writing, if a value of the frame is not finite; throws
@@ -51,6 +54,14 @@ class FrameWriter {
   AppendFile springs_;                                            // open only when asked for
   std::optional<NpyFrameWriter> positions_npy_, velocities_npy_;  // in place of the CSV files
   std::vector<std::filesystem::path> files_;
+  bool page_ = false;
 };
+
+// After a run that was killed (SIGKILL, a crash, a power cut: no chance to cut anything back),
+// the files may end on different frames, one of them in a cut line: each frame goes to the other
+// files first and to energy.csv last, so energy.csv's whole rows are the frames every file
+// holds. Cuts every file in `dir` back to those frames (and a .npy's count with them); returns
+// how many. Throws OutputError naming a file it cannot read or cut. `clothlab repair DIR`.
+long cut_to_common_frames(const std::filesystem::path& dir);
 
 }  // namespace clothlab

@@ -1,5 +1,7 @@
 #include "io/run.hpp"
 
+#include <unistd.h>
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -9,6 +11,7 @@
 
 #include <fmt/format.h>
 
+#include "clothlab/core/stop.hpp"
 #include "io/mesh_export.hpp"
 #include "io/output.hpp"
 #include "io/run_folder.hpp"
@@ -18,10 +21,13 @@ namespace clothlab {
 
 namespace {
 
-volatile std::sig_atomic_t g_stop_signal = 0;
-
+// Says at once that the run heard the signal, with write(2), which a handler may call.
 extern "C" void on_stop_signal(int signal) {
-  g_stop_signal = signal;
+  ask_to_stop(signal);
+  static constexpr char kSaid[] =
+      "\nstopping after this step (a long step is given up part way); a second signal ends the "
+      "run at once\n";
+  [[maybe_unused]] const ssize_t n = ::write(STDERR_FILENO, kSaid, sizeof kSaid - 1);
 }
 
 struct sigaction g_old_int {};
@@ -44,7 +50,7 @@ std::string signal_name(int signal) {
 
 StopSignals::StopSignals() {
   if (g_stop_signals_alive++ > 0) return;
-  g_stop_signal = 0;
+  ask_to_stop(0);
   struct sigaction sa {};
   sa.sa_handler = on_stop_signal;
   sigemptyset(&sa.sa_mask);
@@ -65,18 +71,24 @@ StopSignals::~StopSignals() {
   sigaction(SIGINT, &g_old_int, nullptr);
   sigaction(SIGTERM, &g_old_term, nullptr);
   sigaction(SIGXFSZ, &g_old_xfsz, nullptr);
-  g_stop_signal = 0;
+  ask_to_stop(0);
 }
 
 int StopSignals::received() {
-  return g_stop_signal;
+  return stop_asked();
 }
 
-RunStopped::RunStopped(int signal, long step, long frames)
-    : std::runtime_error(fmt::format("stopped by {} after step {}", signal_name(signal), step)),
+RunStopped::RunStopped(int signal, long step, long frames, long abandoned)
+    : std::runtime_error(
+          abandoned > 0 ? fmt::format("stopped by {} during step {}, given up part way",
+                                      signal_name(signal), abandoned)
+          : abandoned == 0
+              ? fmt::format("stopped by {} before the first frame", signal_name(signal))
+              : fmt::format("stopped by {} after step {}", signal_name(signal), step)),
       signal_(signal),
       step_(step),
-      frames_(frames) {}
+      frames_(frames),
+      abandoned_(abandoned) {}
 
 RunReport run_scene(Scene& scene, const RunOutputs& outputs, const ProgressFn& progress) {
   StopSignals stop_signals;
@@ -88,30 +100,38 @@ RunReport run_scene(Scene& scene, const RunOutputs& outputs, const ProgressFn& p
     return !p.has_filename() && p.has_parent_path() ? p.parent_path() : p;
   };
   const bool page_inside = page && folder_of(outputs.html.parent_path()) == folder_of(outputs.dir);
-  if (page && !page_inside) check_page_target(outputs.html, outputs.force);
+  const PageFolderLock page_lock =
+      page && !page_inside ? check_page_target(outputs.html, outputs.force) : PageFolderLock();
   RunFolder folder(outputs.dir, outputs.force);
-  if (page_inside) check_page_target(outputs.html, outputs.force);
-  FrameWriter writer(outputs.dir, outputs.velocities || scene.output.velocities,
+  if (page_inside) check_page_target(outputs.html, outputs.force, /*lock_folder=*/false);
+  FrameWriter writer(folder.folder(), outputs.velocities || scene.output.velocities,
                      outputs.springs || scene.output.springs, outputs.npy || scene.output.npy,
-                     scene.world.particles.size());
-  MeshExporter meshes(outputs.dir / "frames", outputs.obj, outputs.vtk);
+                     scene.world.particles.size(), page);
+  MeshExporter meshes(folder.folder(), "frames", outputs.obj, outputs.vtk);
   RunReport report;
   report.files = writer.files();
 
   const long total = scene.step_count();
-  // A frame every 1/fps seconds: that many steps, rounded, and at least one.
-  const long steps_per_frame = std::max(1L, std::lround(1.0 / (scene.output.fps * scene.dt)));
+  // A frame every 1/fps seconds: that many steps, rounded, at least one and at most the run's
+  // steps (then the first and the last frame only). Clamped as a double: for a tiny fps,
+  // 1 / (fps dt) is past what a long holds, or inf.
+  const double frame_steps = std::round(1.0 / (scene.output.fps * scene.dt));
+  const long steps_per_frame = !(frame_steps < static_cast<double>(std::max(total, 1L)))
+                                   ? std::max(total, 1L)
+                                   : std::max(1L, static_cast<long>(frame_steps));
   // The first frame, one every steps_per_frame steps, and the last if it falls between.
   const long frames = 1 + total / steps_per_frame + (total % steps_per_frame != 0 ? 1 : 0);
   ViewerRecorder viewer(scene.title, scene.source, frames);
 
   World& world = scene.world;
   long step = 0;
+  long frame_step = 0;  // the step of the last frame written
   const auto write_frame = [&] {
     writer.write(world, report.frames, step);
     meshes.write(world, report.frames + 1);  // mesh files count from 1: frame_0001
     if (page) viewer.offer(world);
     ++report.frames;
+    frame_step = step;
   };
   // The page is rewritten now and then during a long run, so that it is there whatever stops
   // the run; at most every half minute, and at most a twentieth of the time the run takes.
@@ -119,7 +139,11 @@ RunReport run_scene(Scene& scene, const RunOutputs& outputs, const ProgressFn& p
   double page_seconds = 0.0;  // how long the last page took to write [s]
   const auto write_page = [&] {
     const Clock::time_point start = Clock::now();
-    viewer.write(world, outputs.html);
+    if (page_inside) {
+      viewer.write(world, folder.folder(), outputs.html.filename().string());
+    } else {
+      viewer.write(world, outputs.html);
+    }
     page_seconds = seconds_since(start);
     last_page = Clock::now();
   };
@@ -138,9 +162,21 @@ RunReport run_scene(Scene& scene, const RunOutputs& outputs, const ProgressFn& p
 
   const auto start = Clock::now();
   try {
-    write_frame();
+    // A stop asked for during a long step (or the first frame's energy) gives it up part way
+    // (clothlab/core/stop.hpp): the files keep the frames before it.
+    try {
+      const StopPoints points;
+      write_frame();
+    } catch (const StepAbandoned&) {
+      throw RunStopped(StopSignals::received(), 0, 0, 0);
+    }
     for (step = 1; step <= total; ++step) {
-      world.step(scene.dt);
+      try {
+        const StopPoints points;
+        world.step(scene.dt);
+      } catch (const StepAbandoned&) {
+        throw RunStopped(StopSignals::received(), frame_step, report.frames, step);
+      }
       const bool frame_due = step % steps_per_frame == 0 || step == total;
       if (frame_due) write_frame();
       if (progress) progress(step, total);

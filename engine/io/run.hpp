@@ -39,10 +39,13 @@ struct RunReport {
 using ProgressFn = std::function<void(long, long)>;
 
 // While alive, SIGINT (Ctrl-C) and SIGTERM ask a run to stop after its current step instead of
-// ending the process at once; run_scene then writes that step as a last frame and the page, and
-// throws RunStopped. A second signal ends the process as usual (and may cut the frame being
-// written). SIGXFSZ is ignored meanwhile, so that a file past the size limit is an OutputError
-// that names it.
+// ending the process at once, and the run says so on stderr at once; run_scene then writes that
+// step as a last frame and the page, and throws RunStopped. A step that takes long (many
+// substeps or iterations, [gravitation]'s pairs) is given up part way instead
+// (clothlab/core/stop.hpp): the files keep the frames written before it. A second signal ends
+// the process as usual (and may cut the frame being written). SIGXFSZ is ignored meanwhile, so
+// that a file past the size limit is an OutputError that names it. A caller that does long work
+// before run_scene (the start energy) makes one first, so that a signal then is heard too.
 class StopSignals {
  public:
   StopSignals();
@@ -55,14 +58,16 @@ class StopSignals {
 
 class RunStopped : public std::runtime_error {
  public:
-  RunStopped(int signal, long step, long frames);
+  // `abandoned`: the step given up part way (0: the first frame's work), or -1 for none.
+  RunStopped(int signal, long step, long frames, long abandoned = -1);
   int signal() const { return signal_; }
-  long step() const { return step_; }      // the last step taken
-  long frames() const { return frames_; }  // frames written
+  long step() const { return step_; }            // the step of the last frame written
+  long frames() const { return frames_; }        // frames written
+  long abandoned() const { return abandoned_; }  // the step given up part way, or -1
 
  private:
   int signal_;
-  long step_, frames_;
+  long step_, frames_, abandoned_;
 };
 
 // Steps `scene` for its whole duration, writing a frame every 1/fps seconds of simulated time

@@ -8,12 +8,20 @@
 //     (the names in kRunOutputNames, and frames/frame_NNNN.obj|vtk) before its first frame, and
 //     leaves anything else the user put there alone;
 //   - never shares the folder with another run at the same time: it holds a lock on the marker
-//     while it runs (the system lets the lock go when the process ends, however it ends).
+//     while it runs (the system lets the lock go when the process ends, however it ends);
+//   - never writes through a symbolic link: a run folder, a marker or an output that is a link
+//     is not followed (a marker that is not a regular file of one name is refused, an output
+//     name that is a link is removed as a name), so that a link planted in a shared folder
+//     cannot make a run overwrite or delete a file elsewhere.
 #pragma once
 
 #include <array>
 #include <filesystem>
+#include <optional>
 #include <string_view>
+#include <utility>
+
+#include "io/files.hpp"
 
 namespace clothlab {
 
@@ -35,18 +43,38 @@ class RunFolder {
   RunFolder& operator=(const RunFolder&) = delete;
 
   const std::filesystem::path& dir() const { return dir_; }
+  // The folder, held open: the run's files are made through it (io/files.hpp).
+  const Folder& folder() const { return *folder_; }
 
  private:
   std::filesystem::path dir_;
+  std::optional<Folder> folder_;
   int lock_fd_ = -1;
 };
 
 // Whether `dir` is a folder that holds only names a run writes (kRunOutputNames).
 bool holds_only_run_outputs(const std::filesystem::path& dir);
 
-// Throws OutputError if `page` is an existing file that is not a clothlab viewer page (so
-// --html cannot overwrite a user's file by surprise) unless `force`, or if no file can be
-// written where it goes.
-void check_page_target(const std::filesystem::path& page, bool force);
+// The lock of a run folder that a page is written into from outside it (--html): held while
+// the page may be written, so that no run starts there meanwhile.
+class PageFolderLock {
+ public:
+  PageFolderLock() = default;
+  explicit PageFolderLock(int fd) : fd_(fd) {}
+  PageFolderLock(PageFolderLock&& other) noexcept : fd_(std::exchange(other.fd_, -1)) {}
+  PageFolderLock& operator=(PageFolderLock&&) = delete;
+  ~PageFolderLock();
+
+ private:
+  int fd_ = -1;
+};
+
+// Throws OutputError if `page` is an existing file that is not a clothlab viewer page (one that
+// starts as the template does), or a symbolic link, unless `force` (so --html cannot overwrite
+// a user's file by surprise); if no file can be written where it goes; or if it goes into
+// another run's folder while that run writes there. Returns the lock of that folder, when the
+// page goes into one and `lock_folder` (false for the run's own folder, locked already).
+PageFolderLock check_page_target(const std::filesystem::path& page, bool force,
+                                 bool lock_folder = true);
 
 }  // namespace clothlab

@@ -45,7 +45,7 @@ void append_base64(std::string& out, const unsigned char* bytes, size_t size) {
 // (io/files.hpp).
 class PageFile {
  public:
-  explicit PageFile(const std::filesystem::path& page) : file_(page) {
+  PageFile(const Folder& folder, const std::string& name) : file_(folder, name) {
     buffer_.reserve(kChunk + kChunk / 4);
   }
 
@@ -211,6 +211,11 @@ void put_springs(PageFile& file, const World& world, Visit visit) {
 }  // namespace
 
 void ViewerRecorder::write(const World& world, const std::filesystem::path& html) const {
+  write(world, Folder::holding(html), html.filename().string());
+}
+
+void ViewerRecorder::write(const World& world, const Folder& folder,
+                           const std::string& name) const {
   // The frames of the page: those kept, then the last one offered if it is not among them.
   std::vector<const Frame*> frames;
   for (const Frame& frame : kept_)
@@ -267,7 +272,7 @@ void ViewerRecorder::write(const World& world, const std::filesystem::path& html
   if (at == std::string_view::npos) throw std::logic_error("viewer.html has no data marker");
 
   {
-    PageFile file(html);
+    PageFile file(folder, name);
     file.put(kViewerTemplate.substr(0, at));
     file.put(head);
     // Each surface as {"from": first frame, "triangles": [i, j, k, ...]}, the last frame's

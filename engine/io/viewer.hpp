@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "clothlab/core/world.hpp"
+#include "io/files.hpp"
 
 namespace clothlab {
 
@@ -43,6 +44,8 @@ class ViewerRecorder {
   // at every moment the old page or the new one, whole. Throws std::runtime_error naming `html`
   // and the system's reason when it cannot; the temporary file is then removed.
   void write(const World& world, const std::filesystem::path& html) const;
+  // The same for the page `name` in `folder` (a run's folder, held open: io/files.hpp).
+  void write(const World& world, const Folder& folder, const std::string& name) const;
 
   long frames_offered() const { return offered_; }
   long frames_kept() const;  // the frames the page holds, the last one included

@@ -15,6 +15,7 @@
 
 #include <Eigen/Eigenvalues>
 
+#include "analysis/run_cost.hpp"
 #include "analysis/stability.hpp"
 #include "clothlab/core/world.hpp"
 #include "clothlab/forces/damping.hpp"
@@ -509,4 +510,65 @@ duration = 10.0
     else
       CHECK(!(energy(world) < 1e3 * e0));  // grown a thousand times, or no longer finite
   }
+}
+
+namespace {
+
+// A cloth of `rows` x `rows` particles stepped by `integrator` (TOML lines) with `extra` tables.
+clothlab::Scene cost_scene(int rows, const std::string& integrator, const std::string& extra = "") {
+  const std::string text = "[cloth]\nrows = " + std::to_string(rows) +
+                           "\ncols = " + std::to_string(rows) +
+                           "\nspacing = 0.01\nmass = 1\npins = \"top-corners\"\n"
+                           "[springs]\nks = 1000\n[gravity]\n" +
+                           extra + "[integrator]\n" + integrator;
+  return clothlab::parse_scene(text, "<cost>");
+}
+
+}  // namespace
+
+TEST_CASE(
+    "advisor: a run that cannot finish or whose files will not fit is told before it starts") {
+  // 100 x 100: 39402 springs. XPBD with 1000 substeps and 10 iterations projects 3.9e8
+  // constraints a step, about 20 s at 51 ns each: hours for 1000 steps.
+  const std::string xpbd =
+      "method = \"xpbd\"\nsubsteps = 1000\niterations = 10\ndt = 0.01\nduration = 10\n";
+  std::vector<std::string> warnings =
+      clothlab::run_cost_warnings(cost_scene(100, xpbd), false, false, false);
+  REQUIRE(warnings.size() == 1);
+  CHECK(warnings[0].find("XPBD projects 3.94e+08 constraints a step (39402 springs x 1000 "
+                         "substeps x 10 iterations): about 20 s a step and 5.6 h for the run's "
+                         "1000 steps") == 0);
+  // The same for each costly part, and only those the scene has.
+  const std::string plain = "dt = 0.001\nduration = 100\n";
+  warnings = clothlab::run_cost_warnings(
+      cost_scene(100, plain, "[strain_limit]\nmax_strain = 0.1\niterations = 100\n"), false, false,
+      false);
+  REQUIRE(warnings.size() == 1);
+  CHECK(warnings[0].find("[strain_limit] sweeps 39402 springs up to 100 times a step") == 0);
+  warnings = clothlab::run_cost_warnings(
+      cost_scene(100, plain, "[self_collision]\nthickness = 0.001\niterations = 100\n"), false,
+      false, false);
+  REQUIRE(warnings.size() == 1);
+  CHECK(warnings[0].find("[self_collision] checks 10000 particles for pairs up to 100 times") == 0);
+  warnings = clothlab::run_cost_warnings(
+      cost_scene(100, "method = \"local-global\"\niterations = 50\n" + plain), false, false, false);
+  REQUIRE(warnings.size() == 1);
+  CHECK(warnings[0].find("the local/global solver takes 50 iterations a step") == 0);
+  warnings = clothlab::run_cost_warnings(cost_scene(100, "method = \"implicit-euler\"\n" + plain),
+                                         false, false, false);
+  REQUIRE(warnings.size() == 1);
+  CHECK(warnings[0].find("implicit Euler's solve takes up to 500 conjugate-gradient") == 0);
+
+  // 300 x 300 particles at 52 bytes a row, a frame a step for 1000 steps: 1001 frames of 4.68 MB.
+  const std::string every_step = "dt = 0.01\nduration = 10\n[output]\nfps = 100\n";
+  warnings = clothlab::run_cost_warnings(cost_scene(300, every_step), false, false, false);
+  REQUIRE(warnings.size() == 1);
+  CHECK(warnings[0] ==
+        "the run will write about 4.68 GB (1001 frames of 4.68 MB), in CSV files; lower [output] "
+        "fps, or choose format = \"npy\" (12 bytes a particle, not about 52)");
+  CHECK(clothlab::run_cost_warnings(cost_scene(300, every_step), false, false, true).empty());
+
+  // A lesson's scene: nothing to say.
+  CHECK(clothlab::run_cost_warnings(cost_scene(20, "dt = 0.001\nduration = 2\n"), true, true, false)
+            .empty());
 }

@@ -101,6 +101,25 @@ if(NOT page MATCHES "outputs test")
   message(FATAL_ERROR "the page of the stopped run is missing")
 endif()
 
+# A TERM during the start-up work ([gravitation]'s first energy of 40000 particles takes
+# seconds): said at once, and the run ends cleanly (130), not killed by the signal (143).
+file(WRITE ${WORK}/gravitation.toml "[cloth]
+rows = 200
+cols = 200
+spacing = 0.01
+mass = 1
+[gravitation]
+[integrator]
+dt = 0.001
+duration = 1
+")
+execute_process(COMMAND timeout --preserve-status -s TERM 1 ${CLOTHLAB} run
+                        ${WORK}/gravitation.toml --out ${WORK}/gravitation
+                RESULT_VARIABLE code ERROR_VARIABLE err OUTPUT_VARIABLE out)
+if(NOT code EQUAL 130 OR NOT err MATCHES "\nstopping after this step[^\n]*\nstopped by SIGTERM (before the first step|before the first frame|during step 1)")
+  message(FATAL_ERROR "a TERM during the start-up work (exit ${code}):\n${out}${err}")
+endif()
+
 # A folder of the user's, and a page of the user's: refused, and left as they were.
 file(MAKE_DIRECTORY ${WORK}/mine)
 file(WRITE ${WORK}/mine/positions.csv "my own data\n")

@@ -2,18 +2,25 @@
 // and no inf or NaN in any file.
 #include <doctest/doctest.h>
 #include <sys/resource.h>
+#include <unistd.h>
 
+#include <algorithm>
 #include <csignal>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <memory>
 #include <sstream>
 #include <string>
 #include <vector>
 
+#include "clothlab/core/effect.hpp"
 #include "clothlab/core/guard.hpp"
+#include "clothlab/core/stop.hpp"
 #include "io/files.hpp"
+#include "io/npy.hpp"
+#include "io/output.hpp"
 #include "io/run.hpp"
 #include "io/run_folder.hpp"
 #include "scene/scene.hpp"
@@ -359,4 +366,347 @@ TEST_CASE("outputs: format npy writes positions.npy in place of positions.csv, f
   std::memcpy(&x0, npy.data() + 128 + 20 * 400 * 3 * 4, sizeof x0);
   CHECK(x0 == static_cast<float>(scene.world.particles.x(0, 0)));
   CHECK(read_all(dir / "velocities.npy").size() == npy.size());
+}
+
+// The symbolic link attack: a link planted where a run writes (in a shared folder such as /tmp,
+// say) must never make the run write, truncate or delete the file or folder it points to.
+namespace {
+
+// A folder of files a run must never touch, each holding "victim NAME\n".
+fs::path make_victims(const std::string& test, const std::vector<std::string>& names) {
+  const fs::path victims = fresh_dir(test + "-victims");
+  fs::create_directories(victims);
+  for (const std::string& name : names)
+    write_text(victims / name, "victim " + name + "\n");
+  return victims;
+}
+
+void check_victims(const fs::path& victims, const std::vector<std::string>& names) {
+  CHECK(names_in(victims) == names);
+  for (const std::string& name : names)
+    CHECK_MESSAGE(read_all(victims / name) == "victim " + name + "\n", name);
+}
+
+}  // namespace
+
+TEST_CASE("outputs: every writer replaces a symbolic link in its place and not the file it names") {
+  const fs::path dir = fresh_dir("writer-links");
+  fs::create_directories(dir);
+  const std::vector<std::string> names = {"append", "npy", "partial", "replace"};
+  const fs::path victims = make_victims("writer-links", names);
+  fs::create_symlink(victims / "append", dir / "rows.csv");
+  fs::create_symlink(victims / "npy", dir / "x.npy");
+  fs::create_symlink(victims / "replace", dir / "page.html");
+  // The temporary file's name is predictable (the process id): a link planted there.
+  fs::create_symlink(victims / "partial", dir / (".page.html.partial-" + std::to_string(getpid())));
+
+  clothlab::AppendFile rows(dir / "rows.csv");
+  rows.append("mine\n");
+  clothlab::NpyFrameWriter npy(dir / "x.npy", 1);
+  npy.append(clothlab::Matrix3X::Zero(3, 1));
+  clothlab::write_whole_file(dir / "page.html", "my page\n");
+
+  check_victims(victims, names);
+  for (const std::string name : {"rows.csv", "x.npy", "page.html"})
+    CHECK_MESSAGE(fs::is_regular_file(fs::symlink_status(dir / name)), name);
+  CHECK(read_all(dir / "rows.csv") == "mine\n");
+  CHECK(read_all(dir / "page.html") == "my page\n");
+  CHECK(names_in(dir) == std::vector<std::string>{"page.html", "rows.csv", "x.npy"});
+}
+
+TEST_CASE("outputs: a marker that is a link or has a second name is refused and its file kept") {
+  const std::vector<std::string> names = {"marker"};
+  const fs::path victims = make_victims("marker-link", names);
+  const fs::path dir = fresh_dir("marker-link");
+  fs::create_directories(dir);
+  fs::create_symlink(victims / "marker", dir / ".clothlab-run");
+  for (const bool force : {false, true}) {
+    CHECK_THROWS_WITH_AS(clothlab::RunFolder(dir, force),
+                         ((dir / ".clothlab-run").string() +
+                          " is a symbolic link, not clothlab's marker, and a run writes into "
+                          "that file; remove it, or choose another --out")
+                             .c_str(),
+                         OutputError);
+  }
+  // A link to no file at all (which O_CREAT would make): refused too, and nothing made.
+  fs::remove(dir / ".clothlab-run");
+  fs::create_symlink(victims / "new", dir / ".clothlab-run");
+  CHECK_THROWS_WITH_AS(clothlab::RunFolder(dir, true), doctest::Contains("is a symbolic link"),
+                       OutputError);
+  // A hard link: the same file under a second name.
+  fs::remove(dir / ".clothlab-run");
+  fs::create_hard_link(victims / "marker", dir / ".clothlab-run");
+  CHECK_THROWS_WITH_AS(clothlab::RunFolder(dir, true),
+                       doctest::Contains("is a file with other names (hard links), not "
+                                         "clothlab's marker"),
+                       OutputError);
+  fs::remove(dir / ".clothlab-run");
+  check_victims(victims, names);
+
+  // A run folder that is itself a link is not followed.
+  fs::create_directories(victims / "folder");
+  fs::create_symlink(victims / "folder", dir / "out");
+  CHECK_THROWS_WITH_AS(clothlab::RunFolder(dir / "out", true),
+                       ("cannot write into " + (dir / "out").string() +
+                        ": it is a symbolic link, which a run does not follow; give the folder "
+                        "it points to as --out")
+                           .c_str(),
+                       OutputError);
+  CHECK(fs::is_empty(victims / "folder"));
+}
+
+TEST_CASE("outputs: links in a run folder are removed as names and what they point to is kept") {
+  const fs::path dir = fresh_dir("folder-links");
+  const auto run = [&](bool npy) {
+    std::string text = kCloth;
+    text += npy ? "velocities = true\nformat = \"npy\"\n" : "velocities = true\nsprings = true\n";
+    clothlab::Scene scene = clothlab::parse_scene(text, "<cloth>");
+    clothlab::RunOutputs outputs = clothlab::RunOutputs::in(dir);
+    outputs.obj = outputs.vtk = true;
+    return clothlab::run_scene(scene, outputs);
+  };
+  run(false);  // the folder is clothlab's now: a marker, outputs and frames
+  const std::vector<std::string> outputs = {"energy.csv",  "positions.csv",       "velocities.csv",
+                                            "springs.csv", "positions.npy",       "velocities.npy",
+                                            "view.html",   ".view.html.partial-1"};
+  std::vector<std::string> names = outputs;
+  names.push_back("frames");
+  std::sort(names.begin(), names.end());
+  const fs::path victims = make_victims("folder-links", names);
+  fs::remove(victims / "frames");
+  fs::create_directories(victims / "frames");
+  const std::vector<std::string> frames = {"frame_0001.obj", "frame_0002.vtk", "frames.vtk.series"};
+  for (const std::string& frame : frames)
+    write_text(victims / "frames" / frame, "victim frame\n");
+
+  for (const bool npy : {false, true}) {
+    CAPTURE(npy);
+    for (const std::string& name : outputs) {
+      fs::remove(dir / name);
+      fs::create_symlink(victims / name, dir / name);
+    }
+    fs::remove_all(dir / "frames");
+    fs::create_directory_symlink(victims / "frames", dir / "frames");
+    CHECK(run(npy).frames == 21);
+    for (const std::string& name : outputs) {
+      CHECK_MESSAGE(read_all(victims / name) == "victim " + name + "\n", name);
+      CHECK_FALSE(fs::is_symlink(dir / name));
+    }
+    CHECK(names_in(victims / "frames") == frames);
+    CHECK_FALSE(fs::is_symlink(dir / "frames"));
+    CHECK(fs::is_regular_file(dir / "frames" / "frame_0021.obj"));
+  }
+}
+
+TEST_CASE(
+    "outputs: --html is no link nor a note that mentions the viewer nor another run's folder") {
+  const fs::path dir = fresh_dir("html-place");
+  fs::create_directories(dir);
+  const std::vector<std::string> names = {"page"};
+  const fs::path victims = make_victims("html-place", names);
+  // A temporary file's name planted as a link beside the page.
+  fs::create_symlink(victims / "page", dir / (".view.html.partial-" + std::to_string(getpid())));
+  clothlab::Scene scene = clothlab::parse_scene(kCloth, "<cloth>");
+  clothlab::RunOutputs outputs = clothlab::RunOutputs::in(dir / "run");
+  outputs.html = dir / "view.html";
+  CHECK(clothlab::run_scene(scene, outputs).frames == 21);
+  check_victims(victims, names);
+  CHECK(fs::is_regular_file(fs::symlink_status(dir / "view.html")));
+
+  // A link as the page itself: refused unless forced; forced, the link goes, not its file.
+  fs::create_symlink(victims / "page", dir / "link.html");
+  CHECK_THROWS_WITH_AS(clothlab::check_page_target(dir / "link.html", false),
+                       ((dir / "link.html").string() +
+                        " is a symbolic link; choose another --html, or add --force to replace "
+                        "the link (the file it points to is left alone)")
+                           .c_str(),
+                       OutputError);
+
+  // A user's note that names the viewer is not a page.
+  write_text(dir / "notes.html", "<!-- my notes on the clothlab viewer: it is good -->\n");
+  CHECK_THROWS_WITH_AS(clothlab::check_page_target(dir / "notes.html", false),
+                       doctest::Contains("notes.html exists and is not a clothlab viewer page"),
+                       OutputError);
+  CHECK_NOTHROW(clothlab::check_page_target(dir / "view.html", false));  // a page: replaced
+
+  // Into another run's folder while that run writes there: refused.
+  {
+    const clothlab::RunFolder other(dir / "other", false);
+    const std::string busy = "is writing into " + (dir / "other").string() +
+                             " now; wait for it to end, or choose another --html";
+    CHECK_THROWS_WITH_AS(clothlab::check_page_target(dir / "other" / "view.html", false),
+                         doctest::Contains(busy.c_str()), OutputError);
+  }
+  // And while the page may be written there, no run starts in that folder.
+  {
+    const clothlab::PageFolderLock lock =
+        clothlab::check_page_target(dir / "other" / "view.html", false);
+    CHECK_THROWS_WITH_AS(clothlab::RunFolder(dir / "other", false),
+                         doctest::Contains("is writing into"), OutputError);
+  }
+  CHECK_NOTHROW(clothlab::RunFolder(dir / "other", false));
+  check_victims(victims, names);
+}
+
+TEST_CASE("outputs: an fps so small that 1 / (fps dt) overflows writes the first and last frame") {
+  std::string text = kCloth;
+  text.replace(text.find("fps = 100"), 9, "fps = 1e-300");
+  clothlab::Scene scene = clothlab::parse_scene(text, "<cloth>");
+  const clothlab::RunReport report = clothlab::run_scene(scene, fresh_dir("tiny-fps"));
+  CHECK(report.steps == 200);
+  CHECK(report.frames == 2);
+}
+
+TEST_CASE(
+    "outputs: a value past 3.4e38 stops the run before a 32-bit float file or page gets inf") {
+  // The guard's bounds, widened, let a particle fly at 1e40 m/s: x = 1e38 k m after step k, a
+  // double all along, but past the largest float (3.4e38) from step 4 on.
+  const std::string text = R"(
+[guard]
+max_speed = 1e300
+max_position = 1e300
+[[particle]]
+position = [0, 0, 0]
+velocity = [1e40, 0, 0]
+mass = 1
+[integrator]
+dt = 0.01
+duration = 0.1
+[output]
+fps = 100
+)";
+  const fs::path dir = fresh_dir("float-range");
+  clothlab::Scene scene = clothlab::parse_scene(text, "<fast>");
+  CHECK_THROWS_WITH_AS(clothlab::run_scene(scene, dir),
+                       "frame 4 (after step 4, t = 0.04 s) would write a position [m] of 4e+38: "
+                       "more than a 32-bit float holds (3.4e+38), which the page keeps; stopped "
+                       "before writing it (the files hold the frames before it)",
+                       clothlab::SimulationError);
+  std::string energy = read_all(dir / "energy.csv");
+  CHECK(std::count(energy.begin(), energy.end(), '\n') == 1 + 4);
+  CHECK(read_all(dir / "view.html").find("\"times\":[0.0,0.01,0.02,0.03]") != std::string::npos);
+
+  // velocities.npy holds the velocity of 1e40 as a float: refused at frame 0.
+  scene = clothlab::parse_scene(text + "format = \"npy\"\nvelocities = true\n", "<fast>");
+  clothlab::RunOutputs outputs = clothlab::RunOutputs::in(dir);
+  outputs.html.clear();
+  CHECK_THROWS_WITH_AS(clothlab::run_scene(scene, outputs),
+                       doctest::Contains("frame 0 (after step 0, t = 0 s) would write a velocity "
+                                         "[m/s] of 1e+40: more than a 32-bit float holds "
+                                         "(3.4e+38), which velocities.npy keeps"),
+                       clothlab::SimulationError);
+  CHECK(read_all(dir / "positions.npy").find("'shape': (0, 1, 3)") != std::string::npos);
+
+  // The CSV files alone keep doubles: the run goes to its end.
+  scene = clothlab::parse_scene(text, "<fast>");
+  CHECK(clothlab::run_scene(scene, outputs).frames == 11);
+  energy = read_all(dir / "energy.csv");
+  CHECK(std::count(energy.begin(), energy.end(), '\n') == 1 + 11);
+}
+
+namespace {
+
+// A force of nothing that, at its `at`-th evaluation, asks the run to stop as a TERM would: a
+// signal that arrives in the middle of a step, at a known moment.
+class StopAtEvaluation : public clothlab::ForceEffect {
+ public:
+  explicit StopAtEvaluation(long at) : at_(at) {}
+  std::string_view name() const override { return "stop-at-evaluation"; }
+  void add_forces(const clothlab::Particles&, const clothlab::Matrix3X&, const clothlab::Matrix3X&,
+                  clothlab::Matrix3X&) const override {
+    if (++evaluations_ == at_) std::raise(SIGTERM);
+  }
+  mutable long evaluations_ = 0;
+
+ private:
+  long at_;
+};
+
+}  // namespace
+
+TEST_CASE("outputs: a TERM during a step of many substeps gives it up at once") {
+  // XPBD with 2000 substeps a step, one sum of the external forces each: the TERM comes in the
+  // 5th substep of step 3 (evaluation 2 * 2000 + 5), and the run ends in that substep.
+  std::string text = kCloth;
+  text.replace(text.find("[integrator]"), 12,
+               "[integrator]\nmethod = \"xpbd\"\nsubsteps = 2000\niterations = 1");
+  clothlab::Scene scene = clothlab::parse_scene(text, "<cloth>");
+  auto stopper = std::make_unique<StopAtEvaluation>(2 * 2000 + 5);
+  const StopAtEvaluation& counter = *stopper;
+  scene.world.force_effects.push_back(std::move(stopper));
+  const fs::path dir = fresh_dir("term-substeps");
+  try {
+    clothlab::run_scene(scene, dir);
+    FAIL("the run was not stopped");
+  } catch (const clothlab::RunStopped& stop) {
+    CHECK(std::string(stop.what()) == "stopped by SIGTERM during step 3, given up part way");
+    CHECK(stop.abandoned() == 3);
+    CHECK(stop.step() == 0);  // the last frame written: frame 0 (frames are every 10 steps)
+    CHECK(stop.frames() == 1);
+  }
+  CHECK(counter.evaluations_ == 2 * 2000 + 5);  // not one substep more
+  const std::string energy = read_all(dir / "energy.csv");
+  CHECK(std::count(energy.begin(), energy.end(), '\n') == 1 + 1);
+  CHECK(fs::exists(dir / "view.html"));
+  CHECK(clothlab::StopSignals::received() == 0);
+}
+
+TEST_CASE("outputs: the long loops give up their work on a stop only where a run asked them to") {
+  // [gravitation]'s energy, n^2 / 2 pairs, and local/global and strain limiting's iterations.
+  std::string text = kCloth;
+  text += "[gravitation]\n[strain_limit]\nmax_strain = 0.1\n";
+  clothlab::Scene scene = clothlab::parse_scene(text, "<cloth>");
+  const double energy = scene.world.potential_energy();
+  clothlab::ask_to_stop(SIGTERM);
+  CHECK(scene.world.potential_energy() == energy);  // no StopPoints: a test, the game loop
+  {
+    const clothlab::StopPoints points;
+    CHECK_THROWS_AS(scene.world.potential_energy(), clothlab::StepAbandoned);
+    CHECK_THROWS_AS(scene.world.step(0.001), clothlab::StepAbandoned);
+  }
+  clothlab::ask_to_stop(0);
+  const clothlab::StopPoints points;
+  CHECK(scene.world.potential_energy() == energy);
+}
+
+TEST_CASE("outputs: after a SIGKILL every file is cut back to the frames all of them hold") {
+  const fs::path dir = fresh_dir("killed");
+  for (const bool npy : {false, true}) {
+    CAPTURE(npy);
+    std::string text = kCloth;
+    text += npy ? "velocities = true\nformat = \"npy\"\n" : "velocities = true\nsprings = true\n";
+    clothlab::Scene scene = clothlab::parse_scene(text, "<cloth>");
+    clothlab::run_scene(scene, dir);
+    const std::vector<std::string> names =
+        npy ? std::vector<std::string>{"energy.csv", "positions.npy", "velocities.npy"}
+            : std::vector<std::string>{"energy.csv", "positions.csv", "velocities.csv",
+                                       "springs.csv"};
+    std::vector<std::string> whole;
+    for (const std::string& name : names)
+      whole.push_back(read_all(dir / name));
+    // A kill in the middle of frame 21: positions took it whole, velocities a part of it, and
+    // energy.csv a cut line (or, for .npy, the frame's bytes and the count that takes it in).
+    const auto append = [&](const std::string& name, const std::string& more) {
+      std::ofstream(dir / name, std::ios::app | std::ios::binary) << more;
+    };
+    if (npy) {
+      std::string bytes = read_all(dir / "positions.npy");
+      const std::string shape = "'shape': (21, 400, 3)";
+      bytes.replace(bytes.find(shape), shape.size(), "'shape': (22, 400, 3)");
+      write_text(dir / "positions.npy", bytes + std::string(400 * 12, 'x'));
+      append("velocities.npy", std::string(100, 'x'));
+    } else {
+      std::string frame;
+      for (int i = 0; i < 400; ++i)
+        frame += "21,0.21," + std::to_string(i) + ",1,2,3\n";
+      append("positions.csv", frame);
+      append("velocities.csv", frame.substr(0, 1000));
+      append("springs.csv", "21,0.21,springs,0,0,1,0.0");
+    }
+    append("energy.csv", "21,0.2");
+    CHECK(clothlab::cut_to_common_frames(dir) == 21);
+    for (size_t k = 0; k < names.size(); ++k)
+      CHECK_MESSAGE(read_all(dir / names[k]) == whole[k], names[k]);
+    CHECK(clothlab::cut_to_common_frames(dir) == 21);  // a second time: nothing to do
+  }
 }

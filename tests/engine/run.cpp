@@ -205,7 +205,8 @@ fps = 10
   CHECK(data["frames"].size() == data["times"].size());
 }
 
-TEST_CASE("run: velocities.csv and springs.csv when asked for; a hanging mass's spring pulls m g") {
+TEST_CASE(
+    "run: velocities.csv and springs.csv when asked for - a hanging mass's spring pulls m g") {
   // A 0.5 kg mass on a spring (ks = 100 N/m, l0 = 1 m) from a pin, at rest where the spring
   // holds its weight: stretched by m g / ks = 0.049 m, a strain of 0.049 and a tension of
   // m g = 4.9 N, frame after frame.

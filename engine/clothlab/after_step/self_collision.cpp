@@ -2,6 +2,7 @@
 
 #include <chrono>
 
+#include "clothlab/core/stop.hpp"
 #include "clothlab/core/world.hpp"
 
 namespace clothlab {
@@ -24,6 +25,7 @@ void SelfCollision::apply(World& world, double /*dt*/) {
   last_passes_ = 0;
   last_pairs_ = 0;
   for (int pass = 0; pass < iterations_; ++pass) {
+    stop_point();  // many passes of a big cloth can take minutes (core/stop.hpp)
     detect(p.x, world.guard.max_position);
     ++last_passes_;
     if (pass == 0) last_pairs_ = pairs_.size();

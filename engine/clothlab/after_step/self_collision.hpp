@@ -84,6 +84,7 @@ class SelfCollision final : public PostStepEffect {
   long hash_builds() const { return hash_.builds(); }
   std::size_t last_pairs() const { return last_pairs_; }     // found by the last step's first pass
   long total_pairs() const { return total_pairs_; }          // responses over every step so far
+  int iterations() const { return iterations_; }             // most passes in one step
   int last_passes() const { return last_passes_; }           // detection passes of the last step
   double detect_seconds() const { return detect_seconds_; }  // [s] wall time in detection
 

@@ -1,5 +1,6 @@
 #include "clothlab/after_step/strain_limiting.hpp"
 
+#include "clothlab/core/stop.hpp"
 #include "clothlab/core/world.hpp"
 #include "clothlab/forces/spring_damper.hpp"
 
@@ -11,6 +12,7 @@ void StrainLimiting::apply(World& world, double dt) {
   Particles& p = world.particles;
   const double inv_dt = 1.0 / dt;  // [1/s]
   for (int sweep = 0; sweep < iterations_; ++sweep) {
+    stop_point();  // many sweeps of a big cloth can take minutes (core/stop.hpp)
     // Gauss-Seidel: each spring sees the corrections of the springs before it in this sweep.
     bool corrected = false;  // some spring was past its limit by more than rounding
     for (size_t k = 0; k < s.size(); ++k) {

@@ -60,6 +60,7 @@ class StrainLimiting final : public PostStepEffect {
   std::string_view name() const override { return "strain_limit"; }
   void apply(World& world, double dt) override;
 
+  int iterations() const { return iterations_; }       // most sweeps in one step
   int last_sweeps() const { return last_sweeps_; }     // sweeps the last step took
   long total_sweeps() const { return total_sweeps_; }  // over every step so far
   // A sweep whose largest correction is at most this fraction of a rest length ends the loop:

@@ -2,6 +2,7 @@
 
 #include <stdexcept>
 
+#include "clothlab/core/stop.hpp"
 #include "clothlab/core/world.hpp"
 #include "clothlab/forces/spring_damper.hpp"
 
@@ -143,6 +144,7 @@ void LocalGlobal::advance(World& world, double dt) {
   }
 
   for (int it = 0; it < iterations; ++it) {
+    stop_point();  // many iterations of a big cloth can take minutes (core/stop.hpp)
     // Local step: each spring's d, the nearest vector of length l0 to x_i - x_j.
     Index s = 0;
     for (const SpringSet* set : families_) {

@@ -4,6 +4,7 @@
 #include <vector>
 
 #include "clothlab/core/effect.hpp"
+#include "clothlab/core/stop.hpp"
 #include "clothlab/core/world.hpp"
 #include "clothlab/forces/spring_damper.hpp"
 
@@ -60,6 +61,7 @@ void Xpbd::advance(World& world, double dt) {
   }
 
   for (int s = 0; s < substeps; ++s) {
+    stop_point();  // a step of many substeps can take minutes (core/stop.hpp)
     if (s > 0) {
       for (PostStepEffect* contact : contacts)
         contact->before_step(world);  // the substep's start, as World::step does for the step's
@@ -94,6 +96,7 @@ void Xpbd::advance(World& world, double dt) {
     // The projections, Gauss-Seidel: each constraint sees the corrections made before it.
     std::fill(lambda_.begin(), lambda_.end(), 0.0);
     for (int it = 0; it < iterations; ++it) {
+      stop_point();
       size_t c = 0;
       for (const SpringSet* set : families) {
         for (size_t k = 0; k < set->size(); ++k, ++c) {
