@@ -283,7 +283,7 @@ TimeStepAdvice advise_time_step(const World& world, double dt, long steps) {
   // XPBD (lesson 12) moves by constraints, not spring forces: no step limit of its springs to
   // give. (Its explicit external forces and dampers are held by its small substeps.) The
   // local/global solver (lesson 13) steps its springs and dampers implicitly: none either.
-  if (method == "xpbd" || method == "local-global") return advice;
+  if (!world.integrator->springs_without_dt_limit().empty()) return advice;
   // The worst row. Until exercise ex08.1 is done, explicit Euler's limit comes from the
   // eigenvalues, as every other method's does.
   const auto worst_row = [&](const auto& limit) {

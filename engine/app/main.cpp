@@ -33,6 +33,7 @@
 #include "app/demo_scene.hpp"
 #include "app/exit_codes.hpp"
 #include "app/grade.hpp"
+#include "app/grade/text.hpp"
 #include "clothlab/core/not_implemented.hpp"
 #include "clothlab/core/stop.hpp"
 #include "clothlab/integrators/implicit_euler.hpp"
@@ -79,6 +80,13 @@ class ProgressBar {
   std::chrono::steady_clock::time_point start_ = std::chrono::steady_clock::now();
   std::chrono::steady_clock::time_point last_ = start_;
 };
+
+// Text from a scene or the command line (a title, a key, a path) as a message shows it: control
+// characters in caret notation ("^[" for an escape), as the grader shows a submission's output,
+// newlines and tabs too, so that nothing a scene says can move the cursor or start a line.
+std::string shown(const std::string& text) {
+  return app::grading::printable(text, /*keep_lines=*/false);
+}
 
 std::string particle_count(const Scene& scene) {
   const Index n = scene.world.particles.size();
@@ -143,9 +151,9 @@ void warn_unconverged(const World& world) {
 void print_scene_warnings(const Scene& scene, bool velocities, bool springs, bool npy) {
   std::fflush(stdout);  // after what was printed before them
   for (const SceneWarning& warning : scene.warnings)
-    fmt::print(stderr, "warning: {}\n", warning.text());
+    fmt::print(stderr, "warning: {}\n", shown(warning.text()));
   for (const std::string& cost : run_cost_warnings(scene, velocities, springs, npy))
-    fmt::print(stderr, "warning: {}\n", cost);
+    fmt::print(stderr, "warning: {}\n", shown(cost));
 }
 
 int run(Scene& scene, const RunOutputs& outputs, bool stats) {
@@ -154,8 +162,8 @@ int run(Scene& scene, const RunOutputs& outputs, bool stats) {
   if (!out_dir.has_filename() && out_dir.has_parent_path()) out_dir = out_dir.parent_path();
   StepTimes times;
   if (stats) scene.world.timing = &times;
-  fmt::print("clothlab ({} build): {}{}\n", app::kKernels, scene.source,
-             scene.title.empty() ? "" : " - " + scene.title);
+  fmt::print("clothlab ({} build): {}{}\n", app::kKernels, shown(scene.source),
+             scene.title.empty() ? "" : " - " + shown(scene.title));
   fmt::print("  {}; {}; dt = {} s for {} s ({} steps)\n", particle_count(scene),
              scene.world.effects_in_play(), scene.dt, scene.duration, scene.step_count());
   print_scene_warnings(scene, outputs.velocities || scene.output.velocities,
@@ -179,18 +187,15 @@ int run(Scene& scene, const RunOutputs& outputs, bool stats) {
     fmt::print(stderr, "warning: {}\n", advice.warning);
   }
   ProgressBar bar;
-  long steps_done = 0;
-  const auto progress = [&](long done, long total) {
-    steps_done = done;
-    bar(done, total);
-  };
+  const auto progress = [&](long done, long total) { bar(done, total); };
   // Where the frames are, for a run that ended early.
   const auto frames_are_in = [&] {
     std::error_code ec;
     const bool page = !outputs.html.empty() && fs::exists(outputs.html, ec);
     return fmt::format(
-        "{}/{}", out_dir.string(),
-        page ? fmt::format(" and the page {} shows them", outputs.html.string()) : std::string());
+        "{}/{}", shown(out_dir.string()),
+        page ? fmt::format(" and the page {} shows them", shown(outputs.html.string()))
+             : std::string());
   };
   const auto end_bar = [&] {
     std::fflush(stdout);  // what was said before the error comes before it
@@ -201,14 +206,14 @@ int run(Scene& scene, const RunOutputs& outputs, bool stats) {
     const double energy_end = scene.world.kinetic_energy() + scene.world.potential_energy();
     fmt::print("  done: {} steps in {:.3f} s; total energy {:.6g} J -> {:.6g} J\n", report.steps,
                report.wall_seconds, energy_start, energy_end);
-    fmt::print("  wrote {} frames to {}/: ", report.frames, out_dir.string());
+    fmt::print("  wrote {} frames to {}/: ", report.frames, shown(out_dir.string()));
     for (const fs::path& file : report.files) {
       const bool inside = file.parent_path().lexically_normal() == out_dir;
-      fmt::print("{} ", inside ? file.filename().string() : file.string());
+      fmt::print("{} ", shown(inside ? file.filename().string() : file.string()));
     }
     fmt::print("\n");
     if (!outputs.html.empty()) {
-      fmt::print("  watch it: open {} in a browser\n", outputs.html.string());
+      fmt::print("  watch it: open {} in a browser\n", shown(outputs.html.string()));
       if (!report.page_note.empty()) {
         fmt::print("  {}; the {} files have every frame\n", report.page_note,
                    outputs.npy || scene.output.npy ? "data" : "CSV");
@@ -219,7 +224,7 @@ int run(Scene& scene, const RunOutputs& outputs, bool stats) {
     return 0;
   } catch (const SimulationError& error) {
     end_bar();
-    fmt::print(stderr, "error: {}\n", error.what());
+    fmt::print(stderr, "error: {}\n", shown(error.what()));
     if (error.step() <= 0) {
       fmt::print(stderr, "  no frame was written\n");
     } else {
@@ -240,7 +245,9 @@ int run(Scene& scene, const RunOutputs& outputs, bool stats) {
     return app::kExitInterrupted;
   } catch (const OutputError& error) {
     end_bar();
-    fmt::print(stderr, "error: {}\n", error.what());
+    fmt::print(stderr, "error: {}\n", shown(error.what()));
+    // The steps the world took: the frame of the last of them may be the one that failed.
+    const long steps_done = scene.world.steps;
     if (steps_done == 0) {
       fmt::print(stderr, "  nothing was run\n");
       return app::kExitBadInput;
@@ -358,7 +365,7 @@ int main(int argc, char** argv) {
     }
     if (*validate_cmd) {
       const Scene scene = load_scene_file(validate_path);
-      fmt::print("{}: ok: {}; {}; dt = {} s for {} s ({} steps)\n", validate_path,
+      fmt::print("{}: ok: {}; {}; dt = {} s for {} s ({} steps)\n", shown(validate_path),
                  particle_count(scene), scene.world.effects_in_play(), scene.dt, scene.duration,
                  scene.step_count());
       print_scene_warnings(scene, scene.output.velocities, scene.output.springs, scene.output.npy);
@@ -389,14 +396,14 @@ int main(int argc, char** argv) {
     }
   } catch (const SceneError& error) {
     std::fflush(stdout);
-    fmt::print(stderr, "error: {}\n", error.what());
+    fmt::print(stderr, "error: {}\n", shown(error.what()));
     return app::kExitBadInput;
   } catch (const NotImplemented& error) {
     std::fflush(stdout);
-    fmt::print(stderr, "error: {}\n", error.what());
+    fmt::print(stderr, "error: {}\n", shown(error.what()));
     return app::kExitNotDone;
   } catch (const std::exception& error) {
-    fmt::print(stderr, "error: {}\n", error.what());
+    fmt::print(stderr, "error: {}\n", shown(error.what()));
     return app::kExitFailed;
   }
   return 0;

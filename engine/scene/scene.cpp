@@ -3,12 +3,19 @@
 #include <algorithm>
 #include <cctype>
 #include <cmath>
+#include <exception>
 #include <fstream>
+#include <functional>
+#include <initializer_list>
+#include <optional>
 #include <vector>
+
+#include <pthread.h>
 
 #include <fmt/format.h>
 #include <toml++/toml.h>
 
+#include "clothlab/core/not_implemented.hpp"
 #include "fast/engine.hpp"
 #include "scene/scene_reader.hpp"
 #include "scene/scene_tables.hpp"
@@ -506,12 +513,22 @@ std::string explain_toml_error(std::string_view text, const toml::parse_error& e
 // How deep a scene may nest: arrays and inline tables inside each other, or the parts of one
 // dotted key (a.b.c). A scene needs 3 or so; the TOML reader recurses once per level, so a file
 // nested tens of thousands deep would overflow the stack before it could say what is wrong.
+// The deepest tree these limits let through (a 65-part table header, then 64 inline tables in
+// each other, each with a 65-part key: about 4,300 levels) is read in under 512 KiB of stack.
 constexpr int kMaxNesting = 64;
 
 // Fails at the first place `text` nests deeper than kMaxNesting, found without parsing: brackets
-// and braces counted outside strings and comments, and the dots of a run of key parts.
+// and braces counted outside strings and comments, and the dots of a run of key parts. Strings
+// are skipped as TOML 1.0's grammar has them, so that no quote the TOML reader takes for text
+// can hide what follows from the count:
+//   "basic" and 'literal' strings end on their line (a newline in one is an error);
+//   a basic string's backslash escapes the next character ("a\"b" is one string);
+//   """multi-line""" and '''multi-line''' strings end at the first three quotes not escaped,
+//   which may follow one or two quotes of the string's own: """a"""" is the string a", so the
+//   closing run of quotes is 3 to 5 long.
 void check_nesting(std::string_view text, const std::string& source) {
-  long line = 1, column = 0;
+  size_t k = 0;               // the byte looked at
+  long line = 1, column = 1;  // of text[k]; columns count characters, as toml++ does
   int depth = 0, dots = 0;
   const auto fail = [&](std::string_view what) {
     throw SceneError(source, line, column,
@@ -519,38 +536,49 @@ void check_nesting(std::string_view text, const std::string& source) {
                                  "levels (the TOML reader stops here rather than run out of stack)",
                                  what, kMaxNesting));
   };
-  for (size_t k = 0; k < text.size(); ++k) {
+  const auto skip = [&](size_t n) {  // moves past n bytes
+    for (; n > 0 && k < text.size(); --n, ++k) {
+      const auto b = static_cast<unsigned char>(text[k]);
+      if (b == '\n') {
+        ++line;
+        column = 1;
+      } else if ((b & 0xC0) != 0x80) {  // not a UTF-8 continuation byte (10xxxxxx)
+        ++column;
+      }
+    }
+  };
+  const auto at = [&](std::string_view s) { return text.substr(k, s.size()) == s; };
+  while (k < text.size()) {
     const char c = text[k];
-    ++column;
-    if (c == '\n') {
-      ++line;
-      column = 0;
-      dots = 0;
-      continue;
-    }
     if (c == '#') {  // a comment, to the end of its line
-      while (k + 1 < text.size() && text[k + 1] != '\n')
-        ++k;
+      while (k < text.size() && text[k] != '\n')
+        skip(1);
       continue;
     }
-    if (c == '"' || c == '\'') {  // a string, basic or literal, on one line or three quotes
-      const bool triple = text.substr(k, 3) == std::string_view(c == '"' ? "\"\"\"" : "'''");
-      const std::string_view close = triple ? text.substr(k, 3) : text.substr(k, 1);
-      for (k += close.size(); k < text.size(); ++k) {
-        if (text[k] == '\n') {
-          ++line;
-          column = 0;
-        } else {
-          ++column;
+    if (c == '"' || c == '\'') {
+      const bool basic = c == '"';
+      const std::string_view three = basic ? "\"\"\"" : "'''";
+      if (at(three)) {
+        for (skip(3); k < text.size();) {
+          if (basic && text[k] == '\\') {
+            skip(2);  // an escaped character, maybe a quote or a backslash
+          } else if (at(three)) {
+            size_t run = 3;  // the closing quotes: the last three of a run of up to five
+            while (run < 5 && k + run < text.size() && text[k + run] == c)
+              ++run;
+            skip(run);
+            break;
+          } else {
+            skip(1);
+          }
         }
-        if (c == '"' && text[k] == '\\') {
-          ++k;  // an escaped character, maybe a quote
-          ++column;
-          continue;
-        }
-        if (text.substr(k, close.size()) == close) {
-          k += close.size() - 1;
-          break;
+      } else {
+        for (skip(1); k < text.size() && text[k] != '\n';) {
+          const bool escape =
+              basic && text[k] == '\\' && k + 1 < text.size() && text[k + 1] != '\n';
+          const bool closes = text[k] == c;
+          skip(escape ? 2 : 1);
+          if (closes) break;
         }
       }
       continue;
@@ -561,39 +589,141 @@ void check_nesting(std::string_view text, const std::string& source) {
     } else if (c == ']' || c == '}') {
       depth = std::max(0, depth - 1);
       dots = 0;
-    } else if (c == '=' || c == ',') {
+    } else if (c == '=' || c == ',' || c == '\n') {
       dots = 0;
     } else if (c == '.') {
       if (++dots > kMaxNesting) fail("the parts of a dotted key");
     }
+    skip(1);
   }
 }
 
-// Where particle i was made: its [[particle]] table's position, or the key of its body's table
-// that places it (the table itself when the key is absent). [[particle]] tables are read first,
-// so particle i < their count is table #i + 1.
-toml::source_region particle_source(const toml::table& root, const Scene& scene, Index i) {
-  const auto at = [&](std::string_view table, std::string_view key) {
-    const toml::node* t = root.get(table);
-    const toml::node* k = t && t->is_table() ? t->as_table()->get(key) : nullptr;
-    return k ? k->source() : t ? t->source() : toml::source_region{};
-  };
+// The stack the TOML reader and the scene's reading run on [bytes]: a size known in advance,
+// whatever the process's own stack limit (ulimit -s) is, and 128 times what the deepest scene
+// check_nesting lets through needs. It is reserved, not used: only the pages a parse touches
+// cost memory.
+constexpr size_t kReadStackBytes = size_t{64} << 20;
+
+// Runs fn on a thread of its own with a stack of kReadStackBytes and rethrows what it throws; on
+// this thread if the system will not start one (a limit on threads or on memory).
+void on_large_stack(const std::function<void()>& fn) {
+  struct Job {
+    const std::function<void()>* fn;
+    std::exception_ptr error;
+  } job{&fn, nullptr};
+  pthread_attr_t attr;
+  pthread_t thread;
+  bool started = false;
+  if (pthread_attr_init(&attr) == 0) {
+    const auto body = [](void* p) -> void* {
+      Job& j = *static_cast<Job*>(p);
+      try {
+        (*j.fn)();
+      } catch (...) {
+        j.error = std::current_exception();
+      }
+      return nullptr;
+    };
+    started = pthread_attr_setstacksize(&attr, kReadStackBytes) == 0 &&
+              pthread_create(&thread, &attr, body, &job) == 0;
+    pthread_attr_destroy(&attr);
+  }
+  if (!started) return fn();
+  pthread_join(thread, nullptr);
+  if (job.error) std::rethrow_exception(job.error);
+}
+
+// Where a key of the table that made particle i is: the first of `keys` that its [[particle]]
+// table, or its body's table ([rope], [cloth] or [solid]), holds; the table itself when it holds
+// none. [[particle]] tables are read first, so particle i < their count is table #i + 1.
+toml::source_region particle_key(const toml::table& root, const Scene& scene, Index i,
+                                 std::initializer_list<std::string_view> keys) {
+  const toml::table* t = nullptr;
   if (const toml::array* particles = root["particle"].as_array();
       particles && i < static_cast<Index>(particles->size())) {
-    const toml::table& t = *particles->get(static_cast<size_t>(i))->as_table();
-    return t.contains("position") ? t.get("position")->source() : t.source();
+    t = particles->get(static_cast<size_t>(i))->as_table();
+  } else if (scene.rope && i >= scene.rope->first && i < scene.rope->first + scene.rope->count) {
+    t = root["rope"].as_table();
+  } else if (scene.cloth && i >= scene.cloth->first &&
+             i < scene.cloth->first + scene.cloth->size()) {
+    t = root["cloth"].as_table();
+  } else {
+    t = root["solid"].as_table();
   }
-  if (scene.rope && i >= scene.rope->first && i < scene.rope->first + scene.rope->count) {
-    return at("rope", "start");
+  if (!t) return {};
+  for (std::string_view key : keys) {
+    if (const toml::node* k = t->get(key)) return k->source();
   }
-  if (scene.cloth && i >= scene.cloth->first && i < scene.cloth->first + scene.cloth->size()) {
-    return at("cloth", root["cloth"]["origin"] ? "origin" : "spacing");
-  }
-  return at("solid", root["solid"]["corner"] ? "corner" : "size");
+  return t->source();
 }
 
-// The warnings that need the whole scene: particles that start at one point, and an all-pairs
-// effect on many particles.
+// Where particle i was made: the key that places it (position; a rope's start; a cloth's origin,
+// or its spacing; a solid's corner, or its size).
+toml::source_region particle_source(const toml::table& root, const Scene& scene, Index i) {
+  return particle_key(root, scene, i, {"position", "start", "origin", "spacing", "corner", "size"});
+}
+
+// The scene's energy at the start must be a number: a run takes it first (the guard measures
+// growth from it, energy.csv writes it), and refused it at frame 0 when it overflowed. Refused
+// here, at the key responsible: the kinetic energy 1/2 m |v|^2 of the particle with the most (its
+// velocity, or its mass), or the potential energy of the effect that holds it (its constant).
+void check_start_energy(const toml::table& root, const Scene& scene) {
+  const World& world = scene.world;
+  const Particles& p = world.particles;
+  const auto fail = [&](const toml::source_region& where, const std::string& message) {
+    fail_at(scene.source, where, message);
+  };
+  if (const double kinetic = world.kinetic_energy(); !std::isfinite(kinetic)) {
+    Index i = 0;
+    const VectorX each = 0.5 * p.m.array() * p.v.colwise().squaredNorm().transpose().array();
+    each.maxCoeff(&i);
+    fail(particle_key(root, scene, i, {"velocity", "spin", "mass", "density"}),
+         fmt::format("the particles start with a kinetic energy of {} J, too large for a double; "
+                     "particle {} ({}) has the most, 1/2 m |v|^2 = {:.3g} J with m = {:.3g} kg "
+                     "and |v| = {:.3g} m/s; expected a smaller mass or speed",
+                     kinetic, i, describe_particle(scene, i), each[i], p.m[i], p.v.col(i).norm()));
+  }
+  double total = world.kinetic_energy();
+  for (const auto& effect : world.force_effects) {
+    // [gravitation]'s energy sums over every pair: on a large scene, its run takes it (and its
+    // warning says how long that is), not the reader.
+    if (effect->name() == "gravitation" && p.size() > kAllPairsWarnAbove) continue;
+    double energy = 0.0;
+    try {
+      energy = effect->potential_energy(p, p.x);
+    } catch (const NotImplemented&) {
+      continue;  // a student's unfinished energy kernel: the run names the exercise, not the reader
+    }
+    total += energy;
+    if (std::isfinite(energy) && std::isfinite(total)) continue;
+    const std::string_view name = effect->name();
+    // The table that made the effect, and its constant.
+    const std::string_view table = name == "springs" && !root.contains("springs") ? "spring" : name;
+    const toml::node* node = root.get(table);
+    if (const toml::array* list = node ? node->as_array() : nullptr; list && !list->empty()) {
+      node = list->get(0);
+    }
+    const toml::table* t = node ? node->as_table() : nullptr;
+    const toml::node* key = nullptr;
+    for (std::string_view k : {"ks", "g", "G", "volume"}) {
+      if (t && !key) key = t->get(k);
+    }
+    fail(key    ? key->source()
+         : node ? node->source()
+                : toml::source_region{},
+         std::isfinite(energy)
+             ? fmt::format("the scene's energy at the start sums to {} J once the potential "
+                           "energy of {} ({:.3g} J) is added, too large for a double; expected "
+                           "smaller constants, masses or distances",
+                           total, name, energy)
+             : fmt::format("the potential energy of {} at the start is {} J, too large for a "
+                           "double; expected smaller constants, masses or distances",
+                           name, energy));
+  }
+}
+
+// The warnings that need the whole scene: particles that start at one point or inside a
+// collider, and an all-pairs effect on many particles.
 void warn_about_whole_scene(const toml::table& root, Scene& scene) {
   const auto warn = [&](const toml::source_region& where, const std::string& message) {
     scene.warnings.push_back({scene.source, static_cast<long>(where.begin.line),
@@ -610,6 +740,17 @@ void warn_about_whole_scene(const toml::table& root, Scene& scene) {
                      c.second, describe_particle(scene, c.second), at.x(), at.y(), at.z(), c.first,
                      describe_particle(scene, c.first), c.count, c.count == 1 ? "" : "s"));
   }
+  for (const StartInside& in : find_particles_inside(scene.world)) {
+    const Index i = in.first;
+    const Vec3 at = x.col(i);
+    warn(particle_source(root, scene, i),
+         fmt::format("particle {} ({}) starts at ({}, {}, {}) m, {:.3g} m inside {} ({} free "
+                     "particle{} in all start inside it, the deepest {:.3g} m); its first contact "
+                     "pushes them out to its surface at once, a jump that gives them energy no "
+                     "force put in: start them outside it, or pin them",
+                     i, describe_particle(scene, i), at.x(), at.y(), at.z(), in.depth, in.what,
+                     in.count, in.count == 1 ? "" : "s", in.deepest));
+  }
   if (const std::string cost = all_pairs_warning(scene); !cost.empty()) {
     warn(root["gravitation"].node()->source(), cost);
   }
@@ -617,8 +758,10 @@ void warn_about_whole_scene(const toml::table& root, Scene& scene) {
 
 }  // namespace
 
-Scene parse_scene(std::string_view text, const std::string& source) {
-  check_nesting(text, source);
+namespace {
+
+// The scene in `text`, once check_nesting has passed it.
+Scene read_scene(std::string_view text, const std::string& source) {
   toml::table root;
   try {
     root = toml::parse(text, source);
@@ -684,8 +827,20 @@ Scene parse_scene(std::string_view text, const std::string& source) {
     }
   }
   finish_scene(scene, [&](const std::string& message) { fail_at(source, top, message); });
+  check_start_energy(root, scene);
   warn_about_whole_scene(root, scene);
   return scene;
+}
+
+}  // namespace
+
+Scene parse_scene(std::string_view text, const std::string& source) {
+  check_nesting(text, source);
+  // The TOML reader, the reading of the tables and the freeing of the TOML tree recurse once per
+  // level of nesting: on a stack of a known size.
+  std::optional<Scene> scene;
+  on_large_stack([&] { scene = read_scene(text, source); });
+  return std::move(*scene);
 }
 
 Scene load_scene_file(const std::filesystem::path& path) {

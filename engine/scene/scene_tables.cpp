@@ -15,6 +15,7 @@
 #include "clothlab/after_step/strain_limiting.hpp"
 #include "clothlab/after_step/tearing.hpp"
 #include "clothlab/bodies/solid.hpp"
+#include "clothlab/core/threads.hpp"
 #include "clothlab/forces/aerodynamics.hpp"
 #include "clothlab/forces/bending.hpp"
 #include "clothlab/forces/damping.hpp"
@@ -198,6 +199,78 @@ Keyframes read_keyframes(SceneTable& t, std::string_view times_key, std::string_
   return frames;
 }
 
+// A pin path must keep its particles within the guard's bounds: past them the guard stops the run
+// at the step the path gets there (at the start, before step 1, blaming "something outside the
+// step"). The extremes, coordinate by coordinate: keyframes are linear between their offsets, so
+// a pin is farthest at an offset, the farthest of all where the farthest start meets the largest
+// offset, and fastest on a segment; a circle of radius r about its centre c' (the start's foot
+// on the axis a) reaches |c'_j| + r sqrt(1 - a_j^2) along coordinate j, at speeds up to w times
+// the same radius.
+void check_path_within_guard(SceneTable& t, const Scene& scene, const PinPath& path) {
+  const Guard& guard = scene.world.guard;
+  // "WHAT (x, y, z) m, beyond the guard's max_position = ...", at `key`.
+  const auto beyond = [&](std::string_view key, const std::string& what, const Vec3& v,
+                          bool position) {
+    const char* name = position ? "max_position" : "max_speed";
+    const char* unit = position ? "m" : "m/s";
+    const double bound = position ? guard.max_position : guard.max_speed;
+    t.fail(key, fmt::format("{} ({}, {}, {}) {}, beyond the guard's {} = {} {}; expected each "
+                            "component within {} {} (a larger {} in [guard] allows more)",
+                            what, v.x(), v.y(), v.z(), unit, name, bound, unit, bound, unit, name));
+  };
+  const auto within = [](const Vec3& v, double bound) { return (v.array().abs() <= bound).all(); };
+  if (path.offsets.empty()) {
+    const double w = path.angular_speed();
+    for (size_t k = 0; k < path.particles.size(); ++k) {
+      const Vec3 foot = path.centre + (path.x0[k] - path.centre).dot(path.axis) * path.axis;
+      const double r = (path.x0[k] - foot).norm();
+      Vec3 far, fast;
+      for (int j = 0; j < 3; ++j) {
+        const double across = r * std::sqrt(std::max(0.0, 1.0 - path.axis[j] * path.axis[j]));
+        far[j] = std::abs(foot[j]) + across;
+        fast[j] = w * across;
+      }
+      const std::string circle = fmt::format("the circle of pin {} (particle {}) in {}", k,
+                                             path.particles[k], t.display_name());
+      if (!within(far, guard.max_position))
+        beyond("centre", circle + " reaches |x|, |y|, |z| up to", far, true);
+      if (!within(fast, guard.max_speed))
+        beyond("period", circle + " moves it at |vx|, |vy|, |vz| up to", fast, false);
+    }
+    return;
+  }
+  const Keyframes& d = path.offsets;
+  for (int j = 0; j < 3; ++j) {
+    // The pins that start farthest each way along j, and the offsets that take them farthest.
+    size_t lo = 0, hi = 0, dlo = 0, dhi = 0;
+    for (size_t k = 1; k < path.x0.size(); ++k) {
+      if (path.x0[k][j] < path.x0[lo][j]) lo = k;
+      if (path.x0[k][j] > path.x0[hi][j]) hi = k;
+    }
+    for (size_t f = 1; f < d.y.size(); ++f) {
+      if (d.y[f][j] < d.y[dlo][j]) dlo = f;
+      if (d.y[f][j] > d.y[dhi][j]) dhi = f;
+    }
+    for (const auto& [k, f] : {std::pair{lo, dlo}, std::pair{hi, dhi}}) {
+      const Vec3 at = path.x0[k] + d.y[f];
+      if (within(at, guard.max_position)) continue;
+      beyond("offsets",
+             fmt::format("'offsets[{}]' in {} (t = {} s) takes pin {} (particle {}) to", f,
+                         t.display_name(), d.t[f], k, path.particles[k]),
+             at, true);
+    }
+  }
+  for (size_t f = 0; f + 1 < d.t.size(); ++f) {
+    const Vec3 v = d.rate(d.t[f]);
+    if (within(v, guard.max_speed)) continue;
+    beyond("offsets",
+           fmt::format("from 'offsets[{}]' to 'offsets[{}]' in {} (t = {} to {} s), the path "
+                       "moves at",
+                       f, f + 1, t.display_name(), d.t[f], d.t[f + 1]),
+           v, false);
+  }
+}
+
 // A body's [[NAME.pin_path]] tables: pins that follow keyframed offsets or turn on a circle
 // (moving_pins.hpp). The particles they name are pinned; they are put on their paths once the
 // whole scene is read, so that the springs' rest lengths are those of the body as built.
@@ -257,13 +330,13 @@ void read_pin_paths(SceneTable& body, Scene& scene, Index first, Index count,
     }
     if (circle) {
       path.centre = t.required_vec3("centre", "m");
-      path.axis = t.vec3("axis", "", Vec3::UnitZ());
-      if (path.axis == Vec3::Zero()) {
+      const Vec3 axis = t.vec3("axis", "", Vec3::UnitZ());
+      if (axis == Vec3::Zero()) {
         t.fail("axis", fmt::format("'axis' in {} is (0, 0, 0); expected a direction [x, y, z], "
                                    "not zero",
                                    t.display_name()));
       }
-      path.axis.normalize();
+      path.axis = unit_direction(axis);
       path.period = t.required_number("period", Range::positive("s"));
     } else {
       path.offsets = read_keyframes(t, "times", "offsets", "m");
@@ -273,6 +346,7 @@ void read_pin_paths(SceneTable& body, Scene& scene, Index first, Index count,
                                    t.display_name()));
       }
     }
+    check_path_within_guard(t, scene, path);
     for (Index i : pins)
       on_path[static_cast<size_t>(i)] = true;
     scene.pin_paths.push_back(std::move(path));
@@ -603,9 +677,11 @@ void read_buoyancy(SceneTable& t, Scene& scene) {
   double strength = 9.8;
   for (const auto& effect : scene.world.force_effects) {
     if (const auto* gravity = dynamic_cast<const UniformGravity*>(effect.get())) {
-      const double norm = gravity->g().norm();
-      if (norm > 0.0 && std::isfinite(norm)) {
-        down = gravity->g() / norm;
+      if (gravity->g() == Vec3::Zero()) continue;
+      // Scaled first: g = [0, 1e-170, 0] points up, though |g|^2 underflows to 0.
+      const Vec3 along = unit_direction(gravity->g());
+      if (const double norm = gravity->g().dot(along); std::isfinite(norm)) {
+        down = along;
         strength = norm;
       }
     }
@@ -867,7 +943,9 @@ void read_guard(SceneTable& t, Scene& scene) {
 // [engine]: how the engine runs the scene (the physics does not depend on it).
 void read_engine(SceneTable& t, Scene& scene) {
   World& world = scene.world;
-  world.threads = static_cast<int>(t.integer("threads", 1, 1024, world.threads));
+  // 0: every core the machine has, as --threads 0.
+  const long threads = t.integer("threads", 0, 1024, world.threads);
+  world.threads = threads > 0 ? static_cast<int>(threads) : ThreadTeam::hardware_threads();
   if (!t.boolean("fast_path", true)) world.backend.reset();
 }
 

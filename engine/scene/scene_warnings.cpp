@@ -2,10 +2,13 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <numeric>
 #include <vector>
 
 #include <fmt/format.h>
+
+#include "clothlab/after_step/ground_collision.hpp"
 
 namespace clothlab {
 
@@ -32,6 +35,48 @@ CoincidentParticles find_coincident_particles(const Matrix3X& x) {
       found.first = run_first;
       found.second = order[k];
     }
+  }
+  return found;
+}
+
+std::vector<StartInside> find_particles_inside(const World& world) {
+  const Particles& p = world.particles;
+  std::vector<StartInside> found;
+  for (const auto& effect : world.post_step_effects) {
+    // depth(x) > 0: how far x is inside the collider [m], as its collide() measures it.
+    std::function<double(const Vec3&)> depth;
+    StartInside inside;
+    if (const auto* ground = dynamic_cast<const Ground*>(effect.get())) {
+      depth = [y0 = ground->y0()](const Vec3& x) { return y0 - x.y(); };
+      inside.what = fmt::format("the ground [ground] (y = {} m)", ground->y0());
+    } else if (const auto* plane = dynamic_cast<const Plane*>(effect.get())) {
+      depth = [plane](const Vec3& x) { return -(x - plane->point()).dot(plane->normal()); };
+      const Vec3& a = plane->point();
+      const Vec3& n = plane->normal();
+      inside.what = fmt::format(
+          "the [[plane]] through ({}, {}, {}) m facing ({:.3g}, {:.3g}, "
+          "{:.3g})",
+          a.x(), a.y(), a.z(), n.x(), n.y(), n.z());
+    } else if (const auto* sphere = dynamic_cast<const Sphere*>(effect.get())) {
+      depth = [sphere](const Vec3& x) { return sphere->radius() - (x - sphere->centre()).norm(); };
+      const Vec3& c = sphere->centre();
+      inside.what = fmt::format("the [sphere] of radius {} m about ({}, {}, {}) m",
+                                sphere->radius(), c.x(), c.y(), c.z());
+    } else {
+      continue;
+    }
+    for (Index i = 0; i < p.size(); ++i) {
+      const double d = depth(p.x.col(i));
+      if (!(d > 0.0) || p.inv_m[i] == 0.0) continue;  // outside, or pinned: never pushed
+      if (inside.count++ == 0) {
+        inside.first = i;
+        inside.depth = d;
+      }
+      inside.deepest = std::max(inside.deepest, d);
+    }
+    if (inside.count == 0) continue;
+    inside.collider = effect.get();
+    found.push_back(std::move(inside));
   }
   return found;
 }

@@ -1,11 +1,13 @@
 // scene_warnings.hpp: checks of a whole scene that warn rather than refuse.
 //
 // The scene reader warns (Scene::warnings) about inputs that run but are likely mistakes. Most
-// are found where a table is read; the two here need every particle and the run's length:
-// particles that start at the same position, and an all-pairs effect on a large scene.
+// are found where a table is read; those here need every particle and the run's length:
+// particles that start at the same position or inside a collider, and an all-pairs effect on a
+// large scene.
 #pragma once
 
 #include <string>
+#include <vector>
 
 #include "clothlab/core/types.hpp"
 #include "scene/scene.hpp"
@@ -22,6 +24,21 @@ struct CoincidentParticles {
 // Sorts the particles by position, O(n log n): comparing every pair would take n(n-1)/2 steps,
 // 5e11 comparisons for the 10^6 particles a scene may hold.
 CoincidentParticles find_coincident_particles(const Matrix3X& x);
+
+// Free particles (not pinned) that start inside one collider: the ground, a [[plane]] or the
+// [sphere]. Its first contact pushes them out to its surface at once, whatever their depth: a
+// jump, and energy that no force gave.
+struct StartInside {
+  const PostStepEffect* collider = nullptr;
+  std::string what;      // the collider, for people: "the ground (y = 0 m)", ...
+  Index count = 0;       // free particles that start inside it
+  Index first = -1;      // the lowest-numbered of them
+  double depth = 0.0;    // how deep the first is [m]
+  double deepest = 0.0;  // how deep the deepest is [m]
+};
+
+// One entry for each collider of the scene with a particle inside, in the world's order.
+std::vector<StartInside> find_particles_inside(const World& world);
 
 // [gravitation]'s cost per pair and force evaluation [s], measured with the Release build on
 // this project's two-core AMD EPYC build machine (the fastest of six runs, the machine shared):

@@ -4,7 +4,10 @@
 #include <limits>
 #include <string>
 
+#include <fmt/format.h>
+
 #include "clothlab/forces/gravity.hpp"
+#include "clothlab/integrators/integrator.hpp"
 #include "scene/scene.hpp"
 #include "test_util.hpp"
 
@@ -30,7 +33,63 @@ class NanInjector final : public clothlab::ForceEffect {
   clothlab::Index victim_;
 };
 
+// A force along each particle's own velocity, f = c m v with c = 10 1/s: energy from nowhere,
+// which grows as e^(2 c t) whatever the method.
+class Pump final : public clothlab::ForceEffect {
+ public:
+  std::string_view name() const override { return "pump"; }
+  void add_forces(const clothlab::Particles& p, const clothlab::Matrix3X&,
+                  const clothlab::Matrix3X& v, clothlab::Matrix3X& f) const override {
+    for (clothlab::Index i = 0; i < p.size(); ++i)
+      f.col(i) += 10.0 * p.m[i] * v.col(i);
+  }
+};
+
+// The message of the SimulationError that stops `world` within 1000 steps of 0.01 s.
+std::string blow_up_message(clothlab::World& world) {
+  try {
+    for (int s = 0; s < 1000; ++s)
+      world.step(0.01);
+  } catch (const clothlab::SimulationError& e) {
+    return e.what();
+  }
+  FAIL("the guard did not stop the run");
+  return "";
+}
+
 }  // namespace
+
+TEST_CASE("guard: its advice is true for the method: XPBD and local/global have no dt limit") {
+  // Blamed on dt and stability limits, a blow-up under XPBD or the local/global solver sent a
+  // user to shrink a dt that was not the cause: neither has a time-step limit on its springs.
+  const std::string dt_blamed = "A time step too large for the stiffness is the usual cause";
+  const std::string limit_blamed = "dt is above its stability limit";
+  for (const char* method : {"xpbd", "local-global", "symplectic-euler"}) {
+    CAPTURE(method);
+    const bool limited = std::string(method) == "symplectic-euler";
+    const std::string no_limit =
+        fmt::format("{} steps the springs {}, with no time-step limit from their stiffness", method,
+                    std::string(method) == "xpbd" ? "as constraints" : "implicitly");
+    // Beyond a bound: a fall under 1e9 m/s^2 passes 1000 m within a step.
+    clothlab::World falls = test::falling_particle(method, 1.0, Vec3::Zero(), 1e9);
+    falls.guard.max_position = 1000.0;
+    const std::string beyond = blow_up_message(falls);
+    CAPTURE(beyond);
+    CHECK(beyond.find("beyond the guard's bound of 1000 m") != std::string::npos);
+    CHECK((beyond.find(dt_blamed) != std::string::npos) == limited);
+    CHECK((beyond.find(no_limit) != std::string::npos) == !limited);
+    // Energy that runs away: the pump's, found by the energy check.
+    clothlab::World pumped;
+    pumped.particles.add(Vec3::Zero(), Vec3(1, 0, 0), 1.0);
+    pumped.force_effects.push_back(std::make_unique<Pump>());
+    pumped.integrator = clothlab::make_integrator(method);
+    const std::string ran_away = blow_up_message(pumped);
+    CAPTURE(ran_away);
+    CHECK(ran_away.find("simulation ran away") != std::string::npos);
+    CHECK((ran_away.find(limit_blamed) != std::string::npos) == limited);
+    CHECK((ran_away.find(no_limit) != std::string::npos) == !limited);
+  }
+}
 
 TEST_CASE("guard: an injected NaN stops the run at that step naming the particle") {
   clothlab::World world = test::falling_particle("symplectic-euler");

@@ -5,7 +5,9 @@
 
 #include <filesystem>
 #include <fstream>
+#include <random>
 #include <string>
+#include <vector>
 
 #include "scene/scene.hpp"
 
@@ -416,13 +418,36 @@ TEST_CASE("scene error: an array nested 40,000 deep") {
   check_bad_scene("deep_array.toml");
 }
 
+// The same key after a multi-line string that ends in a quote of its own (TOML 1.0 lets it end
+// in one or two): the check took that quote for the start of a one-line string, which it read on
+// across the lines, so the key went uncounted and crashed the TOML reader (SIGSEGV).
+TEST_CASE("scene error: a deep key after a multi-line string that ends in an extra quote") {
+  check_bad_scene("deep_key_after_multiline_string.toml");
+  check_bad_scene("deep_key_after_multiline_literal.toml");
+}
+
+// Starts that `validate` once passed and `run` refused at its first step or frame: a pin path
+// beyond the guard's bounds (blamed on "your own code") or faster than its max_speed, and an
+// energy at the start too large for a double.
+TEST_CASE("scene error: a pin path that leaves the guard's bounds, at its start or later") {
+  check_bad_scene("pin_path_beyond_guard.toml");
+  check_bad_scene("pin_circle_beyond_guard.toml");
+}
+TEST_CASE("scene error: a pin path faster than the guard's max_speed") {
+  check_bad_scene("pin_path_too_fast.toml");
+}
+TEST_CASE("scene error: an energy at the start too large for a double") {
+  check_bad_scene("infinite_kinetic_energy.toml");
+  check_bad_scene("infinite_spring_energy.toml");
+}
+
 TEST_CASE("scene error: every bad scene file has a test case") {
   // A file added to tests/scenes/bad/ without a test above would never be checked.
   int files = 0;
   for (const auto& entry : fs::directory_iterator(fs::path(CLOTHLAB_TEST_SCENES) / "bad")) {
     if (entry.path().extension() == ".toml") ++files;
   }
-  CHECK(files == 115);
+  CHECK(files == 122);
 }
 
 TEST_CASE("scene error: a missing file") {
@@ -460,6 +485,78 @@ TEST_CASE("scene error: nesting tens of thousands deep is refused before the TOM
                              "\n[[particle]]\nposition = [0.5, 1.5, 2.5]\n"
                              "mass = 1.0\n[integrator]\ndt = 0.001\nduration = 0.01\n";
   CHECK_NOTHROW((void)clothlab::parse_scene(quoted, "quoted.toml"));
+}
+
+TEST_CASE("scene error: the nesting check reads TOML's strings as the TOML reader does") {
+  // Each line below ends its string where TOML 1.0 ends it; a key of 100 parts follows on the
+  // next line, which the check must see. Had the check read a string on past its end, the key
+  // would have hidden in it, and its 40,000-part form would have crashed the TOML reader.
+  std::string key;
+  for (int k = 0; k < 99; ++k)
+    key += "a.";
+  key += "a = 1\n";
+  const char* strings[] = {
+      R"(s = """a"""")",       // one quote of the string's own, then the closer: a"
+      R"(s = """a""""")",      // two of its own: a""
+      R"(s = '''a'''')",       // the same for multi-line literal strings
+      R"(s = '''a''''')",      //
+      R"(s = """a\"""")",      // an escaped quote, then the closer: a"
+      R"(s = """a\\""")",      // an escaped backslash, then the closer (not an escaped quote)
+      R"(s = "a\"b")",         // an escaped quote inside a one-line string
+      R"(s = "a\\")",          // an escaped backslash at its end
+      R"(s = 'a\')",           // a literal string has no escapes
+      R"("a.b" = '[{')",       // a quoted key's dots and a literal's brackets are text
+      R"(s = 1 # "unclosed)",  // a quote in a comment opens nothing
+      "s = \"\"\"\na\"\"\n\"\"\"\"",  // a multi-line string over lines, quotes in it and after
+      "s = '''\na''\n'''''",          //
+      "s = \"a\\",                    // one-line strings left open end with their line, where
+      "s = 'a",                       // the TOML reader stops with an error: they do not
+      "s = \"a",                      // swallow the lines after them
+  };
+  for (const char* s : strings) {
+    CAPTURE(s);
+    CHECK_THROWS_WITH_AS((void)clothlab::parse_scene(std::string(s) + "\n" + key, "s.toml"),
+                         doctest::Contains("the parts of a dotted key nest more than 64 deep"),
+                         clothlab::SceneError);
+  }
+}
+
+TEST_CASE("scene error: no string the TOML reader accepts hides a deep key from the check") {
+  // Random runs of quotes (one or three), backslashes, comments and newlines, then a key of 100
+  // parts. Whatever they are, either the check refuses the key, or the TOML reader refuses them:
+  // had the reader accepted them and the check not seen the key, the scene would be refused for
+  // its table [a] instead (and a key of 40,000 parts would have crashed the reader). The check
+  // before this one missed the key in 232 of these 40,000 inputs.
+  std::string key;
+  for (int k = 0; k < 99; ++k)
+    key += "a.";
+  key += "a = 1\n";
+  const std::vector<std::string> pieces = {"\"", "'", "\"\"\"", "\'\'\'", "\\",
+                                           "\n", "#", "a",      " "};
+  std::mt19937 random(40);
+  std::uniform_int_distribution<size_t> piece(0, pieces.size() - 1), length(1, 8);
+  int checked = 0, refused_by_reader = 0;
+  for (int n = 0; n < 40000; ++n) {
+    std::string text = "s = ";
+    for (size_t k = length(random); k > 0; --k)
+      text += pieces[piece(random)];
+    text += "\n" + key;
+    try {
+      (void)clothlab::parse_scene(text, "random.toml");
+      FAIL("a scene of no table loaded: " << text);
+    } catch (const clothlab::SceneError& e) {
+      const std::string what = e.what();
+      const bool nesting =
+          what.find("the parts of a dotted key nest more than 64") != std::string::npos;
+      const bool invalid = what.find("invalid TOML") != std::string::npos;
+      if (!nesting && !invalid) FAIL_CHECK("the key went unseen in:\n" << text << "\n" << what);
+      checked += nesting;
+      refused_by_reader += invalid;
+    }
+  }
+  // Both kinds of input occur: the test is not vacuous.
+  CHECK(checked > 1000);
+  CHECK(refused_by_reader > 500);
 }
 
 TEST_CASE("scene error: a particle on two long pin paths is found without comparing every pair") {

@@ -6,6 +6,8 @@
 #include <numbers>
 #include <string>
 
+#include "clothlab/after_step/moving_pins.hpp"
+#include "clothlab/core/threads.hpp"
 #include "clothlab/forces/aerodynamics.hpp"
 #include "scene/scene.hpp"
 #include "test_util.hpp"
@@ -326,4 +328,42 @@ duration = 1
   CHECK(m[g.at(0, 4)] == doctest::Approx(cell / 3));
   CHECK(m[g.at(3, 0)] == doctest::Approx(cell / 3));
   CHECK((by_area.world.particles.inv_m.array() * m.array() - 1.0).abs().maxCoeff() < 1e-15);
+}
+
+TEST_CASE("scene: [engine] threads = 0 takes every core, as --threads 0 does") {
+  const std::string scene =
+      "[[particle]]\nposition = [0, 0, 0]\nmass = 1\n"
+      "[integrator]\ndt = 0.01\nduration = 0.1\n[engine]\nthreads = ";
+  CHECK(clothlab::parse_scene(scene + "0\n", "t.toml").world.threads ==
+        clothlab::ThreadTeam::hardware_threads());
+  CHECK(clothlab::parse_scene(scene + "3\n", "t.toml").world.threads == 3);
+  CHECK_THROWS_WITH_AS((void)clothlab::parse_scene(scene + "-1\n", "t.toml"),
+                       "t.toml:8:11: 'threads' in [engine] is -1; expected a whole number from 0 "
+                       "to 1024",
+                       clothlab::SceneError);
+}
+
+TEST_CASE("scene keys: a tiny axis, gravity or buoyancy still has its direction") {
+  // |v|^2 of v = [0, 1e-170, 0] underflows to 0: normalised as it is, a pin path's axis stayed
+  // [0, 1e-170, 0] (the circle a line through its centre), and buoyancy's up was NaN. Scaled
+  // first, as [[plane]] normals are, each is the unit vector along v.
+  const std::string body =
+      "[[particle]]\nposition = [0, -1, 0]\nmass = 1\n"
+      "[integrator]\ndt = 0.01\nduration = 0.1\n";
+  clothlab::Scene circle = clothlab::parse_scene(
+      "[rope]\nstart = [0.3, 2, 0]\nend = [0.3, 1, 0]\nparticles = 3\nmass = 0.3\n"
+      "[[rope.pin_path]]\npins = \"first\"\ncentre = [0, 2, 0]\naxis = [0, 1e-170, 0]\n"
+      "period = 2\n[integrator]\ndt = 0.01\nduration = 0.1\n",
+      "axis.toml");
+  const auto& pins =
+      dynamic_cast<const clothlab::MovingPins&>(*circle.world.post_step_effects.back());
+  CHECK(pins.paths()[0].axis == Vec3::UnitY());
+  // [buoyancy] with a tiny g of its own, and against a tiny [gravity] that points up.
+  const auto up = [](const clothlab::Scene& s) {
+    return dynamic_cast<const clothlab::Buoyancy&>(*s.world.force_effects.back()).up();
+  };
+  CHECK(up(clothlab::parse_scene(body + "[buoyancy]\nvolume = 1\ng = 1e-170\n", "b.toml")) ==
+        Vec3::UnitY());
+  CHECK(up(clothlab::parse_scene(body + "[gravity]\ng = [0, 1e-170, 0]\n[buoyancy]\nvolume = 1\n",
+                                 "g.toml")) == -Vec3::UnitY());
 }

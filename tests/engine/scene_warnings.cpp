@@ -229,3 +229,36 @@ TEST_CASE("scene warning: durations for people") {
   CHECK(clothlab::human_duration(3.0 * 86400.0) == "3 days");
   CHECK(clothlab::human_duration(2.0 * 365.25 * 86400.0) == "2 years");
 }
+
+TEST_CASE("scene warning: particles that start inside the ground, a plane or the sphere") {
+  // Once moved out without a word at the first contact: a particle 9 m under the ground jumped
+  // 9 m, and the scene's energy rose tenfold. Pinned particles are never pushed: no warning.
+  const std::string pinned = "[[particle]]\nposition = [5, -3, 0]\nmass = 1\npinned = true\n";
+  const std::string below = particle_at("[0, 1, 0]") + particle_at("[0, -9, 0]") +
+                            particle_at("[1, -2, 0]") + pinned + kIntegrator;
+  CHECK(only_warning(clothlab::parse_scene(below + "[ground]\n", "ground.toml")) ==
+        "ground.toml:5:12: particle 1 ([[particle]] #2) starts at (0, -9, 0) m, 9 m inside the "
+        "ground [ground] (y = 0 m) (2 free particles in all start inside it, the deepest 9 m); "
+        "its first contact pushes them out to its surface at once, a jump that gives them "
+        "energy no force put in: start them outside it, or pin them");
+  CHECK(clothlab::parse_scene(below + "[ground]\ny = -20\n", "deep.toml").warnings.empty());
+
+  const std::string plane = "[[plane]]\npoint = [0, 0, 0]\nnormal = [0, 0, 2]\n";
+  const std::string behind =
+      particle_at("[0, 0, 1]") + particle_at("[3, 4, -0.5]") + kIntegrator + plane;
+  CHECK(only_warning(clothlab::parse_scene(behind, "plane.toml"))
+            .starts_with("plane.toml:5:12: particle 1 ([[particle]] #2) starts at (3, 4, -0.5) "
+                         "m, 0.5 m inside the [[plane]] through (0, 0, 0) m facing (0, 0, 1) (1 "
+                         "free particle in all start inside it, the deepest 0.5 m)"));
+
+  const std::string ball = "[sphere]\ncentre = [1, 1, 1]\nradius = 2\n";
+  CHECK(only_warning(clothlab::parse_scene(
+                         particle_at("[1, 1, 4]") + particle_at("[1, 1, 1.5]") + kIntegrator + ball,
+                         "ball.toml"))
+            .starts_with("ball.toml:5:12: particle 1 ([[particle]] #2) starts at (1, 1, 1.5) m, "
+                         "1.5 m inside the [sphere] of radius 2 m about (1, 1, 1) m (1 free "
+                         "particle in all start inside it, the deepest 1.5 m)"));
+  // On the surface is not inside.
+  CHECK(clothlab::parse_scene(particle_at("[1, 1, 3]") + kIntegrator + ball, "on.toml")
+            .warnings.empty());
+}

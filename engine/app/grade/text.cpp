@@ -36,12 +36,12 @@ std::string valid_utf8(const std::string& in) {
 // Text a submission wrote (its messages, its output, the compiler's quotes of its code) made
 // safe for a terminal: valid UTF-8, with control characters shown in caret notation ("^[" for
 // an escape), so that it cannot move the cursor, clear the screen or draw a fake result.
-std::string printable(const std::string& text) {
+std::string printable(const std::string& text, bool keep_lines) {
   const std::string in = valid_utf8(text);
   std::string out;
   for (std::size_t i = 0; i < in.size(); ++i) {
     const auto b = static_cast<unsigned char>(in[i]);
-    if (b == '\n' || b == '\t') {
+    if (keep_lines && (b == '\n' || b == '\t')) {
       out += in[i];
     } else if (b < 0x20 || b == 0x7f) {
       out += '^';

@@ -15,8 +15,9 @@ namespace clothlab::app::grading {
 std::string valid_utf8(const std::string& in);
 
 // Text a submission wrote made safe for a terminal: valid UTF-8, with control characters shown in
-// caret notation ("^[" for an escape).
-std::string printable(const std::string& text);
+// caret notation ("^[" for an escape). Newlines and tabs are kept, unless `keep_lines` is false
+// (then "^J" and "^I"): for text that one line of a message quotes, a title or a path.
+std::string printable(const std::string& text, bool keep_lines = true);
 
 // `text` with `prefix` before each of its lines.
 std::string indent(const std::string& text, const std::string& prefix);

@@ -90,9 +90,7 @@ class Plane final : public PostStepEffect {
  public:
   // `normal` need not be of unit length; it must not be zero.
   Plane(const Vec3& point, const Vec3& normal, const ContactMaterial& material)
-      : point_(point),
-        normal_((normal / normal.cwiseAbs().maxCoeff()).normalized()),  // no overflow in |normal|
-        material_(material) {}
+      : point_(point), normal_(unit_direction(normal)), material_(material) {}
   std::string_view name() const override { return "plane"; }
   void before_step(const World& world) override { start_.record(world); }
   bool each_substep() const override { return true; }

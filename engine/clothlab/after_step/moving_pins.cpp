@@ -9,23 +9,15 @@
 
 namespace clothlab {
 
-namespace {
-
-double angular_speed(const PinPath& path) {  // w = 2 pi / period [rad/s]
-  return 2.0 * std::numbers::pi / path.period;
-}
-
-}  // namespace
-
 Vec3 PinPath::position(size_t k, double t) const {
   if (!offsets.empty()) return x0[k] + offsets.at(t);
-  const Eigen::AngleAxisd turn(angular_speed(*this) * t, axis);
+  const Eigen::AngleAxisd turn(angular_speed() * t, axis);
   return centre + turn * Vec3(x0[k] - centre);
 }
 
 Vec3 PinPath::velocity(size_t k, double t) const {
   if (!offsets.empty()) return offsets.rate(t);
-  return (angular_speed(*this) * axis).cross(position(k, t) - centre);
+  return (angular_speed() * axis).cross(position(k, t) - centre);
 }
 
 double PinPath::top_speed() const {
@@ -36,7 +28,7 @@ double PinPath::top_speed() const {
     return top;
   }
   for (size_t k = 0; k < x0.size(); ++k)  // |w a x (x - c)| = w times the distance from the axis
-    top = std::max(top, angular_speed(*this) * axis.cross(Vec3(x0[k] - centre)).norm());
+    top = std::max(top, angular_speed() * axis.cross(Vec3(x0[k] - centre)).norm());
   return top;
 }
 

@@ -12,6 +12,7 @@
 // its springs see the pin move, and an integrator's trial states carry it along the path.
 #pragma once
 
+#include <numbers>
 #include <vector>
 
 #include "clothlab/core/effect.hpp"
@@ -30,6 +31,7 @@ struct PinPath {
   Vec3 position(size_t k, double t) const;  // of particles[k] at time t [m]
   Vec3 velocity(size_t k, double t) const;  // [m/s]
   double top_speed() const;                 // the largest |v| on the path [m/s]
+  double angular_speed() const { return 2.0 * std::numbers::pi / period; }  // a circle's w [rad/s]
 };
 
 class MovingPins final : public PostStepEffect {

@@ -7,6 +7,7 @@
 #include <fmt/format.h>
 
 #include "clothlab/core/world.hpp"
+#include "clothlab/integrators/integrator.hpp"
 
 namespace clothlab {
 
@@ -32,6 +33,21 @@ Index first_bad_column(const Matrix3X& a, double bound) {
     }
   }
   return -1;
+}
+
+// What makes a state run away with the world's method, said true for it. A method whose stable dt
+// the springs bound (lesson 08) is usually past that bound; XPBD and the local/global solver have
+// none there, so a smaller dt is no cure on the springs: the cause is elsewhere.
+std::string likely_cause(const World& world, std::string_view symptom) {
+  const std::string_view how =
+      world.integrator ? world.integrator->springs_without_dt_limit() : std::string_view();
+  if (how.empty()) return std::string(symptom);
+  return fmt::format(
+      "{} steps the springs {}, with no time-step limit from their stiffness, so a smaller dt "
+      "is not the cure there: look for a force it takes explicitly that is far too strong for "
+      "the step (wind, drag, gravitation between particles that come close), a pin path that "
+      "moves too fast, or a force with the wrong sign",
+      world.integrator->name(), how);
 }
 
 }  // namespace
@@ -66,10 +82,12 @@ void Guard::check(const World& world, bool before_step) const {
           : fmt::format("{} is not finite ({}, {}, {})", quantity, value.x(), value.y(), value.z());
   // The likely cause differs: a NaN is born from 0/0 (a zero length, two particles at the same
   // place); a value that grows past any bound is energy that the integrator keeps adding.
-  const char* advice =
+  const std::string advice =
       value.allFinite()
-          ? "A time step too large for the stiffness is the usual cause (try a smaller dt or "
-            "another integrator); a force with the wrong sign does the same at any dt"
+          ? likely_cause(world,
+                         "A time step too large for the stiffness is the usual cause (try a "
+                         "smaller dt or another integrator); a force with the wrong sign does "
+                         "the same at any dt")
           : "A NaN usually comes from a division by zero (a zero length, two particles at the "
             "same place) or from values that overflowed after growing without bound";
   if (before_step) {
@@ -120,12 +138,15 @@ void Guard::check_energy(const World& world) const {
       fmt::format("simulation ran away at step {} (t = {:.6g} s): the total energy rose from "
                   "{:.6g} J to {:.6g} J, more than max_energy_growth = {} times the scene's "
                   "energy scale of {:.3g} J, energy that no force put in; particle {} moves "
-                  "fastest ({:.3g} m/s). Effects in play: {}. The integrator is adding energy: "
-                  "dt is above its stability limit, or the method gains energy at any dt on "
-                  "undamped springs (explicit Euler, midpoint). `clothlab validate` estimates "
-                  "the limit; raise [guard] max_energy_growth if the energy is meant to grow",
+                  "fastest ({:.3g} m/s). Effects in play: {}. {}; raise [guard] "
+                  "max_energy_growth if the energy is meant to grow",
                   world.steps, world.t, energy_start_, energy, max_energy_growth, energy_scale(),
-                  fastest, p.v.col(fastest).norm(), world.effects_in_play()),
+                  fastest, p.v.col(fastest).norm(), world.effects_in_play(),
+                  likely_cause(world,
+                               "The integrator is adding energy: dt is above its stability "
+                               "limit, or the method gains energy at any dt on undamped springs "
+                               "(explicit Euler, midpoint). `clothlab validate` estimates the "
+                               "limit")),
       world.steps, fastest);
 }
 

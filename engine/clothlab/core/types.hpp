@@ -16,4 +16,10 @@ using VectorX = Eigen::VectorXd;    // one scalar per particle
 
 using Index = Eigen::Index;
 
+// The unit vector along v (not zero, finite): v is first divided by its largest |component|, so
+// that |v|^2 neither underflows to 0 (v = [0, 1e-170, 0]) nor overflows to infinity (1e170).
+inline Vec3 unit_direction(const Vec3& v) {
+  return (v / v.cwiseAbs().maxCoeff()).normalized();
+}
+
 }  // namespace clothlab

@@ -120,7 +120,11 @@ class Buoyancy final : public ForceEffect {
  public:
   // g: the gravitational acceleration [m/s^2], a vector (not zero).
   Buoyancy(double rho, double volume, double surface, const Vec3& g)
-      : rho_(rho), volume_(volume), surface_(surface), g_(g.norm()), up_(-g / g.norm()) {}
+      : rho_(rho),
+        volume_(volume),
+        surface_(surface),
+        g_(g.dot(unit_direction(g))),  // |g|, where |g|^2 may underflow (g = 1e-170)
+        up_(-unit_direction(g)) {}
   std::string_view name() const override { return "buoyancy"; }
   void add_forces(const Particles& p, const Matrix3X& x, const Matrix3X& v,
                   Matrix3X& f) const override;

@@ -26,6 +26,11 @@ class Integrator {
   // Force evaluations per step, for reports ("4" for RK4). The implicit integrator also solves
   // a linear system; its cost is in its own statistics.
   virtual int force_evaluations_per_step() const = 0;
+
+  // How the method steps the springs, when it has no time-step limit on them (XPBD: as
+  // constraints; local/global: implicitly, by projections); "" for a method whose stable dt the
+  // springs' stiffness bounds (lesson 08). The time-step advisor and the guard's advice ask it.
+  virtual std::string_view springs_without_dt_limit() const { return ""; }
 };
 
 // The force-based integrators of lessons 01 to 08, which lesson 07 compares: what a scene may

@@ -57,6 +57,7 @@ class LocalGlobal final : public Integrator {
   void advance(World& world, double dt) override;
   // The external forces are summed once per step.
   int force_evaluations_per_step() const override { return 1; }
+  std::string_view springs_without_dt_limit() const override { return "implicitly"; }
 
   int iterations = 10;  // local and global steps per time step ([integrator] iterations)
 

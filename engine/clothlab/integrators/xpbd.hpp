@@ -61,6 +61,7 @@ class Xpbd final : public Integrator {
   void advance(World& world, double dt) override;
   // The external forces are summed once per substep.
   int force_evaluations_per_step() const override { return substeps; }
+  std::string_view springs_without_dt_limit() const override { return "as constraints"; }
 
   int substeps = 10;   // substeps per step ([integrator] substeps)
   int iterations = 1;  // projections of every constraint per substep ([integrator] iterations)
