@@ -529,7 +529,7 @@ void read_bending(SceneTable& t, Scene& scene) {
   const double ks = t.required_number("ks", Range::non_negative("N/m"));
   const double kd = t.number("kd", Range::non_negative("N s/m"), 0.0);
   const Matrix3X& x = scene.world.particles.x;
-  // The cloth's bending layer (exercise 4.1 picks its pairs), then the rope's, if any.
+  // The cloth's bending layer (exercise ex04.1 picks its pairs), then the rope's, if any.
   SpringSet bending = scene.cloth ? bending_springs(*scene.cloth, ks, kd, x) : SpringSet{};
   if (scene.rope) {
     add_spring_family(bending, rope_bending_pairs(scene.rope->count), scene.rope->first, ks, kd, x);
