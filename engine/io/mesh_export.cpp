@@ -5,6 +5,7 @@
 
 #include <fmt/format.h>
 
+#include "clothlab/bodies/normals.hpp"
 #include "clothlab/forces/spring_damper.hpp"
 #include "io/files.hpp"
 
@@ -30,25 +31,6 @@ std::vector<SpringView> all_springs(const World& world) {
 }
 
 }  // namespace
-
-Matrix3X vertex_normals(const Matrix3X& x, const std::vector<Triangle>& triangles) {
-  Matrix3X normals;
-  vertex_normals(x, triangles, normals);
-  return normals;
-}
-
-void vertex_normals(const Matrix3X& x, const std::vector<Triangle>& triangles, Matrix3X& normals) {
-  normals.setZero(3, x.cols());
-  for (const Triangle& t : triangles) {
-    const Vec3 n_star = (x.col(t[1]) - x.col(t[0])).cross(x.col(t[2]) - x.col(t[0]));
-    for (Index i : t)
-      normals.col(i) += n_star;
-  }
-  for (Index i = 0; i < normals.cols(); ++i) {
-    const double length = normals.col(i).norm();
-    if (length > 0.0) normals.col(i) /= length;
-  }
-}
 
 MeshExporter::MeshExporter(const Folder& parent, const std::string& name, bool obj, bool vtk)
     : obj_(obj), vtk_(vtk) {

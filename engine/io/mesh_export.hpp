@@ -36,10 +36,4 @@ class MeshExporter {
   std::vector<std::pair<std::string, double>> vtk_files_;  // name and time [s]
 };
 
-// Per-vertex normals: the area-weighted average of the normals of the triangles around each
-// vertex (the cross product's length is twice the area, so plain sums weight by area).
-Matrix3X vertex_normals(const Matrix3X& x, const std::vector<Triangle>& triangles);
-// The same into `normals`, resized to 3 x N: no allocation when it has that size already.
-void vertex_normals(const Matrix3X& x, const std::vector<Triangle>& triangles, Matrix3X& normals);
-
 }  // namespace clothlab

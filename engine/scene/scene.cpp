@@ -166,10 +166,40 @@ double checked_number(const toml::node& node, const std::string& source, std::st
 
 }  // namespace
 
+void SceneTable::record_tunables(std::string_view keys, std::string path, bool defaults,
+                                 std::vector<TunableNumber>& out) {
+  tunable_keys_ = keys;
+  path_ = std::move(path);
+  record_defaults_ = defaults;
+  tunables_ = &out;
+}
+
+void SceneTable::record(std::string_view key, std::optional<size_t> element, double value,
+                        const Range& range, bool in_text) {
+  if (!tunables_ || (!in_text && !record_defaults_)) return;
+  if (!is_one_of(key, tunable_keys_)) return;
+  std::string path = fmt::format("{}.{}", path_, key);
+  if (element) path += fmt::format("[{}]", *element);
+  TunableNumber number{
+      path, value, range.min, range.max, range.min_exclusive, std::string(range.unit), in_text};
+  for (TunableNumber& known : *tunables_) {
+    if (known.path == number.path) {  // read twice: the last reading holds
+      known = number;
+      return;
+    }
+  }
+  tunables_->push_back(std::move(number));
+}
+
 double SceneTable::number(std::string_view key, const Range& range, double fallback) {
   const toml::node* node = as_table(node_).get(key);
-  if (!node) return fallback;
-  return checked_number(*node, source_, fmt::format("'{}' in {}", key, name_), range);
+  if (!node) {
+    record(key, std::nullopt, fallback, range, false);
+    return fallback;
+  }
+  const double x = checked_number(*node, source_, fmt::format("'{}' in {}", key, name_), range);
+  record(key, std::nullopt, x, range, true);
+  return x;
 }
 
 double SceneTable::required_number(std::string_view key, const Range& range) {
@@ -182,7 +212,11 @@ double SceneTable::required_number(std::string_view key, const Range& range) {
 
 Vec3 SceneTable::vec3(std::string_view key, std::string_view unit, const Vec3& fallback) {
   const toml::node* node = as_table(node_).get(key);
-  if (!node) return fallback;
+  if (!node) {
+    for (size_t k = 0; k < 3; ++k)
+      record(key, k, fallback[static_cast<Index>(k)], Range::any(unit), false);
+    return fallback;
+  }
   const toml::array* array = node->as_array();
   const std::string expected = fmt::format("an array of three numbers [x, y, z] [{}]", unit);
   if (!array) {
@@ -199,6 +233,7 @@ Vec3 SceneTable::vec3(std::string_view key, std::string_view unit, const Vec3& f
   for (int k = 0; k < 3; ++k) {
     result[k] = checked_number((*array)[static_cast<size_t>(k)], source_,
                                fmt::format("'{}[{}]' in {}", key, k, name_), Range::any(unit));
+    record(key, static_cast<size_t>(k), result[k], Range::any(unit), true);
   }
   return result;
 }
@@ -818,11 +853,16 @@ Scene read_scene(std::string_view text, const std::string& source) {
       for (size_t i = 0; i < array.size(); ++i) {
         SceneTable table(array[i].as_table(), fmt::format("[[{}]] #{}", kind.name, i + 1), source);
         table.check_keys(kind.keys);
+        // A key absent from one of several tables cannot be added by its path: no defaults.
+        table.record_tunables(kind.tunable, fmt::format("{}[{}]", kind.name, i), false,
+                              scene.tunables);
         kind.read(table, scene);
       }
     } else {
       SceneTable table(node->as_table(), fmt::format("[{}]", kind.name), source);
       table.check_keys(kind.keys);
+      table.record_tunables(kind.tunable, std::string(kind.name), !node->as_table()->is_inline(),
+                            scene.tunables);
       kind.read(table, scene);
     }
   }

@@ -49,6 +49,18 @@ struct SceneWarning {
   std::string text() const;  // "FILE:LINE:COL: message"
 };
 
+// A number of the scene that a running program may change while the motion goes on (a live
+// page's slider): the tables declare which of their keys are such (SceneTableKind::tunable), and
+// the reader records each as it reads it, with the values it accepts.
+struct TunableNumber {
+  std::string path;  // where it is: "springs.ks", "aerodynamics.wind[2]", "plane[1].e"
+  double value = 0.0;
+  double min = 0.0, max = 0.0;  // the values the reader accepts (may be infinite)
+  bool min_exclusive = false;   // true: value must be > min
+  std::string unit;
+  bool in_text = true;  // false: the reader's default, the key absent from the text
+};
+
 struct OutputSettings {
   double fps = 30.0;        // frames written per simulated second [1/s]
   bool velocities = false;  // also velocities.csv: each particle's velocity, every frame
@@ -63,7 +75,8 @@ struct Scene {
   double dt = 0.0;        // time step [s]
   double duration = 0.0;  // simulated time [s]
   OutputSettings output;
-  std::vector<SceneWarning> warnings;  // inputs that run but are likely mistakes, as found
+  std::vector<SceneWarning> warnings;   // inputs that run but are likely mistakes, as found
+  std::vector<TunableNumber> tunables;  // what a running program may change, in reading order
 
   // What the builders made, for the tables read after them (springs, bending, aerodynamics).
   std::optional<ClothGrid> cloth;

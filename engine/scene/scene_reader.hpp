@@ -76,10 +76,24 @@ class SceneTable {
 
   const std::string& display_name() const { return name_; }
 
+  // From now on, each number (or element of a vector) this table reads under one of the keys
+  // in `keys` (names separated by spaces) is recorded in `out`, as `path.key`: `path` is where
+  // the table is ("springs", "plane[1]"). A key the text lacks is recorded with its default
+  // when `defaults` is true (a program may add it under the table).
+  void record_tunables(std::string_view keys, std::string path, bool defaults,
+                       std::vector<TunableNumber>& out);
+
  private:
+  void record(std::string_view key, std::optional<size_t> element, double value, const Range& range,
+              bool in_text);
+
   const void* node_;
   std::string name_;  // "[gravity]" or "[[particle]] #2"
   const std::string& source_;
+  std::string_view tunable_keys_;  // record_tunables()
+  std::string path_;
+  bool record_defaults_ = false;
+  std::vector<TunableNumber>* tunables_ = nullptr;
 };
 
 // The name in `candidates` (separated by spaces) nearest to `typo`, or "" if none is close.

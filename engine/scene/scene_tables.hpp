@@ -18,6 +18,10 @@ struct SceneTableKind {
   std::string_view keys;     // every key the table may hold, separated by spaces
   std::string_view summary;  // what the table holds, quoted when it is missing
   void (*read)(SceneTable& table, Scene& scene);
+  // The keys whose numbers a running program may change while the motion goes on (a live
+  // page's sliders): the physics, not the geometry, the step or the output. Recorded in
+  // Scene::tunables with the values the reader accepts.
+  std::string_view tunable = "";
 };
 
 // Every table, in the order they are read: parts first, then effects, then run settings.

@@ -1,6 +1,6 @@
 // live.cpp: the engine as the live lesson pages see it, compiled to WebAssembly.
 //
-// The page drives one Simulation (clothlab/core/game_loop.hpp, lesson 11) through these few C
+// The page drives one Simulation (scene/simulation.hpp, lesson 11) through these few C
 // functions: it loads a scene from TOML text, advances it by the frame times of the browser,
 // reads the positions and the energies straight out of the module's memory, and pins, drags and
 // frees particles with the mouse. A slider is a number in the scene's TOML: the page changes the
@@ -28,12 +28,12 @@
 
 #include "clothlab/after_step/ground_collision.hpp"
 #include "clothlab/after_step/tearing.hpp"
-#include "clothlab/core/game_loop.hpp"
 #include "clothlab/core/guard.hpp"
 #include "clothlab/core/not_implemented.hpp"
 #include "clothlab/forces/spring_damper.hpp"
 #include "clothlab/integrators/integrator.hpp"
 #include "scene/scene.hpp"
+#include "scene/simulation.hpp"
 
 namespace {
 
@@ -71,43 +71,19 @@ int guarded(Work&& work) {
   }
 }
 
-// The numbers of a scene a page may turn into sliders: every number (or element of an array of
-// numbers) of every table, with where its text is, so the page can put a new value in its place.
-void list_numbers(const toml::table& table, const std::string& prefix, nlohmann::json& out) {
-  for (const auto& [key, node] : table) {
-    const std::string name =
-        prefix.empty() ? std::string(key.str()) : prefix + "." + std::string(key.str());
-    const auto add = [&](const toml::node& value, const std::string& label) {
-      const toml::source_region& where = value.source();
-      out.push_back({{"name", label},
-                     {"value", value.value<double>().value_or(0.0)},
-                     {"integer", value.is_integer()},
-                     {"line", where.begin.line},
-                     {"column", where.begin.column},
-                     {"end_line", where.end.line},
-                     {"end_column", where.end.column}});
-    };
-    if (node.is_number()) {
-      add(node, name);
-    } else if (const toml::table* inner = node.as_table()) {
-      list_numbers(*inner, name, out);
-    } else if (const toml::array* array = node.as_array()) {
-      const bool all_numbers = std::all_of(array->begin(), array->end(),
-                                           [](const toml::node& n) { return n.is_number(); });
-      if (all_numbers && array->size() <= 4) {
-        for (size_t k = 0; k < array->size(); ++k)
-          add((*array)[k], fmt::format("{}[{}]", name, k));
-      }
-    }
-  }
-}
-
-void describe(const std::string& text) {
+// The numbers of the scene a page may turn into sliders: those the scene reader declares
+// tunable (Scene::tunables), each with the values it accepts (a bound that is infinite is null).
+void describe(const clothlab::Scene& scene) {
   nlohmann::json numbers = nlohmann::json::array();
-  try {
-    list_numbers(toml::parse(text), "", numbers);
-  } catch (const std::exception&) {
-    // The scene reader has read it: this cannot fail; if it does, no sliders.
+  const auto bound = [](double x) { return std::isfinite(x) ? nlohmann::json(x) : nullptr; };
+  for (const clothlab::TunableNumber& t : scene.tunables) {
+    numbers.push_back({{"name", t.path},
+                       {"value", t.value},
+                       {"min", bound(t.min)},
+                       {"max", bound(t.max)},
+                       {"min_exclusive", t.min_exclusive},
+                       {"unit", t.unit},
+                       {"in_text", t.in_text}});
   }
   g_parameters = numbers.dump();
 }
@@ -240,7 +216,7 @@ EMSCRIPTEN_KEEPALIVE int clothlab_load(const char* text, const char* name) {
     for (Index i = 0; i < p.size(); ++i)
       g_pinned_by_scene[static_cast<size_t>(i)] = p.inv_m[i] == 0.0;
     take_surface();
-    describe(text);
+    describe(g_simulation->scene());
   });
 }
 

@@ -123,9 +123,10 @@
     if (text === null) return false;
     const status = api.reload(text, sceneName);
     if (status !== 0) {
-      // The value is refused (out of range, ...): say why, keep the scene that ran.
+      // The value is refused: say why. The engine kept the scene that ran, untouched (a scene
+      // it cannot read replaces nothing), and the sliders go back to its numbers.
       showMessage(`${path} = ${value}: ${api.message()}`, 'error');
-      api.reload(sceneText, sceneName);
+      buildSliders();
       return false;
     }
     showMessage('', '');
@@ -153,9 +154,6 @@
     $('play').textContent = running ? 'Pause' : 'Play';
   }
 
-  // The numbers a slider is offered for: the physics, not the geometry or the output.
-  const kSliderTables = /^(springs|bending|aerodynamics|drag|damping|gravity|gravitation|ground|sphere|plane|tearing|plasticity|strain_limiting|buoyancy|self_collision)\./;
-
   function formatValue(v) {
     if (v === 0) return '0';
     const a = Math.abs(v);
@@ -163,25 +161,38 @@
   }
 
   // A slider over [value / 10, value * 10] on a log scale for a positive number; linear over
-  // a symmetric range for one that may be negative or is 0.
+  // a symmetric range for one that may be negative or is 0. Either is cut to the values the
+  // scene reader accepts (p.min, p.max: null where there is no bound); null when that leaves
+  // no room to move.
   function sliderScale(p) {
     const v = p.value;
-    if (v > 0 && !p.name.includes('[')) {
-      const lo = Math.log(v / 10), hi = Math.log(v * 10);
-      return { to: (s) => Math.exp(lo + (hi - lo) * s), from: (x) => (Math.log(x) - lo) / (hi - lo) };
+    const lo = p.min ?? -Infinity, hi = p.max ?? Infinity;
+    if (v > 0 && !p.name.endsWith(']')) {
+      const a = Math.max(v / 10, lo), b = Math.min(v * 10, hi);
+      if (!(a > 0 && b > a)) return null;
+      const la = Math.log(a), lb = Math.log(b);
+      return { to: (s) => Math.exp(la + (lb - la) * s), from: (x) => (Math.log(x) - la) / (lb - la) };
     }
     const span = Math.max(Math.abs(v) * 3, 1);
-    return { to: (s) => -span + 2 * span * s, from: (x) => (x + span) / (2 * span) };
+    const a = Math.max(-span, lo), b = Math.min(span, hi);
+    if (!(b > a)) return null;
+    return { to: (s) => a + (b - a) * s, from: (x) => (x - a) / (b - a) };
   }
 
-  // A slider's label under its table's heading: `aerodynamics.wind[2]` is `wind z` under
-  // `aerodynamics` (a vector of three is x, y, z), `springs.ks` is `ks` under `springs`.
+  // A slider's table and label: `aerodynamics.wind[2]` is `wind z` under `[aerodynamics]` (a
+  // vector of three is x, y, z), `springs.ks` is `ks` under `[springs]`, `plane[1].e` is `e`
+  // under `[[plane]] #2`.
+  function sliderHeading(name) {
+    const head = name.slice(0, name.indexOf('.'));
+    const repeated = /^(\w+)\[(\d+)\]$/.exec(head);
+    return repeated ? `[[${repeated[1]}]] #${Number(repeated[2]) + 1}` : `[${head}]`;
+  }
   function sliderLabel(name) {
-    const dot = name.indexOf('.');
-    const key = name.slice(dot + 1);
+    const key = name.slice(name.lastIndexOf('.') + 1);
     const element = /^(.*)\[(\d)\]$/.exec(key);
     if (!element) return key;
-    const size = parameters.filter((q) => q.name.startsWith(`${name.slice(0, name.lastIndexOf('['))}[`)).length;
+    const vector = name.slice(0, name.lastIndexOf('['));
+    const size = parameters.filter((q) => q.name.startsWith(`${vector}[`)).length;
     return size === 3 ? `${element[1]} ${'xyz'[Number(element[2])]}` : key;
   }
 
@@ -190,13 +201,14 @@
     box.textContent = '';
     let table = '';
     for (const p of parameters) {
-      if (!kSliderTables.test(p.name) || p.integer) continue;
-      const heading = p.name.slice(0, p.name.indexOf('.'));
+      const scale = sliderScale(p);
+      if (!scale) continue;
+      const heading = sliderHeading(p.name);
       if (heading !== table) {
         table = heading;
         const title = document.createElement('div');
         title.className = 'slider-table';
-        title.textContent = `[${heading}]`;
+        title.textContent = heading;
         box.append(title);
       }
       const row = document.createElement('label');
@@ -210,7 +222,6 @@
       input.max = 1000;
       input.dataset.name = p.name;
       const out = document.createElement('output');
-      const scale = sliderScale(p);
       input.value = Math.round(1000 * scale.from(p.value));
       out.textContent = formatValue(p.value);
       input.addEventListener('input', () => {

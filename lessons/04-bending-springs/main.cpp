@@ -7,7 +7,7 @@
 //   3. a light sheet draped over a rod, once without bending springs and with soft and stiff
 //      ones: how far its free edges sag once it has settled.
 // ./build/lesson04 runs on the reference solutions, ./build/lesson04-student on your exercises;
-// while exercise 4.1 is still a stub, the program names it and exits with code 4.
+// while exercise ex04.1 is still a stub, the program names it and exits with code 4.
 #include <algorithm>
 #include <cmath>
 #include <exception>

@@ -1,5 +1,5 @@
 // Lesson 05: a particle meets the ground. Measures what the lesson's README quotes:
-//   0. one collision response worked by hand (exercise 5.1);
+//   0. one collision response worked by hand (exercise ex05.1);
 //   1. bounce heights against the e^2 law;
 //   2. sliding distance against v0^2 / (2 mu_d g);
 //   3. the lecture's simple friction against Coulomb friction on the same slide, at two steps.

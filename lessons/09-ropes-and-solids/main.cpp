@@ -1,5 +1,5 @@
 // Lesson 09: ropes, soft solids and strain limiting. Measures what the lesson's README quotes:
-//   1. one strain-limiting correction, worked by hand (the kernel of exercise 9.1);
+//   1. one strain-limiting correction, worked by hand (the kernel of exercise ex09.1);
 //   2. the jelly cube's springs, family by family, against the counting formulas;
 //   3. the soft cloth hanging from two corners, with and without [strain_limit]: its sag, its
 //      largest strain, the sweeps strain limiting took, and what stiffer springs would cost;

@@ -60,7 +60,7 @@ Closest closest_pair(const Matrix3X& x, const Matrix3X& x_rest, double thickness
 }
 
 void by_hand() {
-  fmt::print("1. Cells of edge h = 0.25 m, and their slots in a table of 1000 (exercise 10.1)\n");
+  fmt::print("1. Cells of edge h = 0.25 m, and their slots in a table of 1000 (exercise ex10.1)\n");
   fmt::print("   {:>20}  {:>14}  {:>6}\n", "x [m]", "cell", "slot");
   for (const Vec3& x :
        {Vec3(0.1, 0.3, 0.6), Vec3(-0.1, 0.1, 0.0), Vec3(0.5, -0.5, 0.0), Vec3(0.3, 0.6, 0.9)}) {
@@ -69,7 +69,7 @@ void by_hand() {
                fmt::format("({}, {}, {})", c.ix, c.iy, c.iz), cell_hash(c, 1000));
   }
   fmt::print(
-      "   One pair (exercise 10.2): r1 = (0, 0, 0), r2 = (0.03, 0, 0.04), thickness 0.06 m\n");
+      "   One pair (exercise ex10.2): r1 = (0, 0, 0), r2 = (0.03, 0, 0.04), thickness 0.06 m\n");
   const SelfContact contact{0.06, 0.0, 0.3, 0.2};
   for (const auto& [w1, w2] : {std::pair{1.0, 1.0}, {3.0, 1.0}, {0.0, 1.0}}) {
     const PairState out =

@@ -23,7 +23,7 @@
 #include <fmt/format.h>
 
 #include "../common/lesson.hpp"
-#include "clothlab/core/game_loop.hpp"
+#include "scene/simulation.hpp"
 #include "clothlab/core/not_implemented.hpp"
 #include "io/viewer.hpp"
 

@@ -13,7 +13,6 @@
 
 #include <fmt/format.h>
 
-#include "app/exit_codes.hpp"
 #include "clothlab/core/not_implemented.hpp"
 #include "clothlab/core/world.hpp"
 #include "clothlab/forces/spring_damper.hpp"
@@ -56,6 +55,10 @@ inline double seconds_since(Clock::time_point start) {
   return std::chrono::duration<double>(Clock::now() - start).count();
 }
 
+// A lesson program's exit status: the codes `clothlab` itself gives (engine/app/exit_codes.hpp),
+// so that a script reads both alike (tests/engine/lesson_common.cpp checks they agree).
+enum ExitCode : int { kExitOk = 0, kExitFailed = 1, kExitNotDone = 4 };
+
 // Runs the lesson's tables and says what stopped them: an exercise still a stub (exit code 4,
 // as `clothlab run` gives), or any other error (1). A body may return an exit code of its own.
 template <class Body>
@@ -68,12 +71,12 @@ int run(const char* program, Body body) {
     }
   } catch (const NotImplemented& error) {
     fmt::print(stderr, "{}: {}\n", program, error.what());
-    return app::kExitNotDone;
+    return kExitNotDone;
   } catch (const std::exception& error) {
     fmt::print(stderr, "{}: {}\n", program, error.what());
-    return app::kExitFailed;
+    return kExitFailed;
   }
-  return app::kExitOk;
+  return kExitOk;
 }
 
 // x >= 0 with `decimals` decimals, rounded down: a stable limit printed must hold at exactly the

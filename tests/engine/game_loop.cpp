@@ -9,7 +9,7 @@
 #include <string>
 #include <vector>
 
-#include "clothlab/core/game_loop.hpp"
+#include "scene/simulation.hpp"
 #include "clothlab/core/guard.hpp"
 #include "clothlab/forces/aerodynamics.hpp"
 

@@ -13,7 +13,7 @@
 #include <vector>
 
 #include "clothlab/bodies/cloth.hpp"
-#include "clothlab/core/game_loop.hpp"
+#include "scene/simulation.hpp"
 #include "clothlab/core/world.hpp"
 #include "clothlab/forces/gravity.hpp"
 #include "clothlab/forces/spring_damper.hpp"

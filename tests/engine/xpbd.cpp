@@ -11,7 +11,6 @@
 #include <string>
 
 #include "clothlab/after_step/ground_collision.hpp"
-#include "clothlab/core/game_loop.hpp"
 #include "clothlab/core/guard.hpp"
 #include "clothlab/integrators/xpbd.hpp"
 #include "scene/scene.hpp"

@@ -1,6 +1,8 @@
 # Fails when a file of the lecture's engine (ENGINE/clothlab/, every folder under it) includes
-# anything from the engine room (ENGINE/fast/): the physics knows the fast engine only through
-# clothlab/core/backend.hpp. Names each offending file and line.
+# anything from outside it: the engine room (ENGINE/fast/, which the physics knows only through
+# clothlab/core/backend.hpp), or the rooms built on the physics (scene/, io/, app/, web/,
+# analysis/). The physics wing imports nothing but itself and the libraries. Names each
+# offending file and line.
 file(GLOB_RECURSE physics ${ENGINE}/clothlab/*.hpp ${ENGINE}/clothlab/*.cpp ${ENGINE}/clothlab/*.in)
 list(LENGTH physics count)
 if(count LESS 20)
@@ -9,14 +11,26 @@ if(count LESS 20)
 endif()
 set(breaches "")
 foreach(path ${physics})
-  file(STRINGS ${path} lines REGEX "^[ \t]*#[ \t]*include[ \t]*[<\"]fast/")
+  file(STRINGS ${path} lines REGEX "^[ \t]*#[ \t]*include[ \t]*[<\"]")
+  file(READ ${path} text)
   foreach(line ${lines})
-    file(RELATIVE_PATH name ${ENGINE} ${path})
-    string(APPEND breaches "\n  ${name}: ${line}")
+    if(line MATCHES "^[ \t]*#[ \t]*include[ \t]*[<\"](fast|scene|io|app|web|analysis)/")
+      # The line's number, for the message: one more than the line ends before it.
+      string(FIND "${text}" "${line}" at)
+      string(SUBSTRING "${text}" 0 ${at} before)
+      string(REGEX MATCHALL "\n" ends "${before}")
+      list(LENGTH ends number)
+      math(EXPR number "${number} + 1")
+      file(RELATIVE_PATH name ${ENGINE} ${path})
+      string(APPEND breaches "\n  engine/${name}:${number}: ${line}")
+    endif()
   endforeach()
 endforeach()
 if(breaches)
-  message(FATAL_ERROR "the lecture's engine includes the engine room (engine/fast/); reach it "
-                      "through World::backend instead:${breaches}")
+  message(FATAL_ERROR "the lecture's engine (engine/clothlab/) includes from outside it; the "
+                      "engine room is reached through World::backend, and the rooms above the "
+                      "physics (scene/, io/, app/, web/, analysis/) include the physics, never the "
+                      "other way:${breaches}")
 endif()
-message(STATUS "${count} files of engine/clothlab/ checked: none includes engine/fast/")
+message(STATUS "${count} files of engine/clothlab/ checked: none includes from fast/, scene/, "
+               "io/, app/, web/ or analysis/")

@@ -52,6 +52,16 @@
         continue;
       }
       page.setRunning(false);
+      // Every effect the scene names has its sliders, offered by the engine's scene reader:
+      // each table but those that set up bodies, the step, the output and the engine. (The page
+      // once kept a list of its own, which named [strain_limiting] for lesson 09's
+      // [strain_limit].)
+      const headings = Array.from(document.querySelectorAll('#sliders .slider-table'), (n) => n.textContent);
+      const effects = Array.from(scene.text.matchAll(/^\s*\[\[?\s*([A-Za-z_]+)\s*\]/gm), (m) => m[1])
+        .filter((t) => !/^(guard|particle|rope|cloth|solid|integrator|output|engine|title)$/.test(t));
+      const bare = effects.filter((t) => !headings.some((h) => h === `[${t}]` || h.startsWith(`[[${t}]]`)));
+      say(`${scene.name}: each effect of the scene has its sliders`, bare.length === 0,
+          `no slider under ${bare.join(', ')}; headings: ${headings.join(' ')}`);
       const method = /^\s*method\s*=\s*"([^"]+)"/m.exec(scene.text);
       const shown = document.getElementById('integrator').value;
       say(`${scene.name}: the integrator menu shows the scene's method`,

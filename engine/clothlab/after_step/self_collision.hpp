@@ -11,7 +11,7 @@
 // left out: they are held apart by their springs, and pushing them to `thickness` would fight
 // the springs every step.
 //
-// Response (exercise 10.2), for a pair at r1, r2 with velocities v1, v2 and inverse masses
+// Response (exercise ex10.2), for a pair at r1, r2 with velocities v1, v2 and inverse masses
 // w1, w2 [1/kg] (0: pinned), d = |r2 - r1| < thickness, n = (r2 - r1) / d:
 //
 //   positions  C = thickness - d, how deep the pair overlaps [m]
@@ -69,7 +69,7 @@ class SelfCollision final : public PostStepEffect {
   // returns every pair i < j closer than the thickness that is not excluded at rest.
   const std::vector<IndexPair>& detect(const Matrix3X& x, double bound);
 
-  // Response alone: each pair, in the order given, through pair_response (exercise 10.2), the
+  // Response alone: each pair, in the order given, through pair_response (exercise ex10.2), the
   // particles' x and v updated before the next pair is taken (Gauss-Seidel).
   void respond(Particles& p, const std::vector<IndexPair>& pairs) const;
 

@@ -5,7 +5,7 @@
 // 80 x 80 cloth, every step. Yet a particle can only touch particles within `thickness` of it.
 // Cut space into cubic cells of edge h >= thickness; a particle at x lies in the cell
 //
-//   (ix, iy, iz) = (floor(x / h), floor(y / h), floor(z / h))       (exercise 10.1)
+//   (ix, iy, iz) = (floor(x / h), floor(y / h), floor(z / h))       (exercise ex10.1)
 //
 // and any particle closer than h to it lies in the same cell or in one of the 26 around it. Space
 // is unbounded, so the cells are not stored as a 3D array; their coordinates are hashed into a

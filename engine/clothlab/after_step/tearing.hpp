@@ -5,7 +5,7 @@
 // spring that reached across the torn spring. Which springs break
 // in a step must not depend on the order they are stored in: otherwise the same cloth would
 // tear differently after an unrelated change to how it was built. So the choice is made on the
-// springs' strains and their end particles only (exercise 6.2), and applied all at once.
+// springs' strains and their end particles only (exercise ex06.2), and applied all at once.
 #pragma once
 
 #include <utility>

@@ -13,7 +13,7 @@ void Aerodynamics::add_forces(const Particles& /*p*/, const Matrix3X& x, const M
                               Matrix3X& f) const {
   for (const Triangle& t : triangles_) {
     const Vec3 f_aero = aerodynamic_force(x.col(t[0]), x.col(t[1]), x.col(t[2]), v.col(t[0]),
-                                          v.col(t[1]), v.col(t[2]), v_air_, rho_, cd_);
+                                          v.col(t[1]), v.col(t[2]), air_.velocity(), rho_, cd_);
     const Vec3 share = f_aero / 3.0;  // each corner carries a third of the triangle
     f.col(t[0]) += share;
     f.col(t[1]) += share;
@@ -24,7 +24,7 @@ void Aerodynamics::add_forces(const Particles& /*p*/, const Matrix3X& x, const M
 void FluidDrag::add_forces(const Particles& p, const Matrix3X& /*x*/, const Matrix3X& v,
                            Matrix3X& f) const {
   for (Index i = 0; i < p.size(); ++i)
-    f.col(i) += fluid_drag_force(v.col(i), v_air_, rho_, cd_, area_);
+    f.col(i) += fluid_drag_force(v.col(i), fluid_.velocity(), rho_, cd_, area_);
 }
 
 void Buoyancy::add_forces(const Particles& p, const Matrix3X& x, const Matrix3X& /*v*/,

@@ -41,22 +41,19 @@ Vec3 fluid_drag_force(const Vec3& v, const Vec3& v_air, double rho, double cd, d
 class Aerodynamics final : public ForceEffect {
  public:
   Aerodynamics(std::vector<Triangle> triangles, double rho, double cd, const Vec3& v_air)
-      : triangles_(std::move(triangles)), rho_(rho), cd_(cd), v_air_(v_air) {}
+      : triangles_(std::move(triangles)), rho_(rho), cd_(cd), air_(v_air) {}
   std::string_view name() const override { return "aerodynamics"; }
   void add_forces(const Particles& p, const Matrix3X& x, const Matrix3X& v,
                   Matrix3X& f) const override;
-  // Wind may change while the simulation runs (a gust, a game's weather).
-  void set_wind(const Vec3& v_air) { v_air_ = v_air; }
-  const Vec3& wind() const { return v_air_; }  // [m/s]
-  // Wind that changes in time by itself (wind.hpp): from then on each step takes its own.
-  void set_gusts(const Wind& gusts) { gusts_ = gusts; }
-  void set_time(double t) override {
-    if (gusts_.changes()) v_air_ = gusts_.at(t);
-  }
+  // Wind may change while the simulation runs (a gust, a game's weather), or by itself in
+  // time (wind.hpp).
+  void set_wind(const Vec3& v_air) { air_.set_velocity(v_air); }
+  const Vec3& wind() const { return air_.velocity(); }  // [m/s]
+  void set_gusts(const Wind& gusts) { air_.set_gusts(gusts); }
+  void set_time(double t) override { air_.set_time(t); }
   // 1/2 M |wind|^2: the kinetic energy of particles carried along at the wind's top speed.
   double energy_scale(const Particles& p, const Matrix3X& /*x*/, double /*size*/) const override {
-    const double top = std::max(v_air_.norm(), gusts_.top_speed());
-    return 0.5 * p.m.sum() * top * top;
+    return air_.carried_energy(p.m.sum());
   }
   double rho() const { return rho_; }  // [kg/m^3]
   double cd() const { return cd_; }
@@ -76,40 +73,35 @@ class Aerodynamics final : public ForceEffect {
 
   std::vector<Triangle> triangles_;
   unsigned long version_ = next_version();
-  double rho_;  // air density [kg/m^3]
-  double cd_;   // drag coefficient
-  Vec3 v_air_;  // wind velocity [m/s]
-  Wind gusts_;  // how it changes in time, if it does
+  double rho_;   // air density [kg/m^3]
+  double cd_;    // drag coefficient
+  AirFlow air_;  // the wind [m/s]
 };
 
 class FluidDrag final : public ForceEffect {
  public:
   FluidDrag(double rho, double cd, double area, const Vec3& v_air)
-      : rho_(rho), cd_(cd), area_(area), v_air_(v_air) {}
+      : rho_(rho), cd_(cd), area_(area), fluid_(v_air) {}
   std::string_view name() const override { return "drag"; }
   void add_forces(const Particles& p, const Matrix3X& x, const Matrix3X& v,
                   Matrix3X& f) const override;
   // The fluid's flow may change in time (wind.hpp), as the wind on triangles.
-  void set_gusts(const Wind& gusts) { gusts_ = gusts; }
-  void set_time(double t) override {
-    if (gusts_.changes()) v_air_ = gusts_.at(t);
-  }
+  void set_gusts(const Wind& gusts) { fluid_.set_gusts(gusts); }
+  void set_time(double t) override { fluid_.set_time(t); }
   // 1/2 M |v_fluid|^2, as for the wind on triangles.
   double energy_scale(const Particles& p, const Matrix3X& /*x*/, double /*size*/) const override {
-    const double top = std::max(v_air_.norm(), gusts_.top_speed());
-    return 0.5 * p.m.sum() * top * top;
+    return fluid_.carried_energy(p.m.sum());
   }
   double rho() const { return rho_; }  // [kg/m^3]
   double cd() const { return cd_; }
-  double area() const { return area_; }                  // [m^2]
-  const Vec3& fluid_velocity() const { return v_air_; }  // [m/s]
+  double area() const { return area_; }                             // [m^2]
+  const Vec3& fluid_velocity() const { return fluid_.velocity(); }  // [m/s]
 
  private:
-  double rho_;   // fluid density [kg/m^3]
-  double cd_;    // drag coefficient
-  double area_;  // cross-sectional area of each particle [m^2]
-  Vec3 v_air_;   // fluid velocity [m/s]
-  Wind gusts_;   // how it changes in time, if it does
+  double rho_;     // fluid density [kg/m^3]
+  double cd_;      // drag coefficient
+  double area_;    // cross-sectional area of each particle [m^2]
+  AirFlow fluid_;  // the fluid's velocity [m/s]
 };
 
 // Buoyancy (game-physics lecture): a particle below the fluid's surface is pushed against gravity

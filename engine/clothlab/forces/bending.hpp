@@ -5,7 +5,7 @@
 // are not neighbours. Flexion (bending) springs join particles two apart, (i, j)-(i+2, j) and
 // (i, j)-(i, j+2); folding the row shortens them, so they push back. They get their own ks and
 // kd, usually much softer than the structural springs: cloth resists bending far less than
-// stretching. The pairs are built by bending_pairs() (exercise 4.1, declared in cloth.hpp);
+// stretching. The pairs are built by bending_pairs() (exercise ex04.1, declared in cloth.hpp);
 // the force is the same spring-damper as lesson 02, in an effect named "bending".
 #pragma once
 

@@ -39,4 +39,29 @@ struct Wind {
   }
 };
 
+// The air (or fluid) an effect feels now: its velocity, and how that changes in time if it does.
+// The air on triangles and a fluid's drag on particles both hold one.
+class AirFlow {
+ public:
+  explicit AirFlow(const Vec3& v_air) : v_air_(v_air) {}
+  const Vec3& velocity() const { return v_air_; }  // [m/s]
+  // Changed while the simulation runs (a gust, a game's weather).
+  void set_velocity(const Vec3& v_air) { v_air_ = v_air; }
+  // Changes in time by itself (Wind above): from then on each step takes its own.
+  void set_gusts(const Wind& gusts) { gusts_ = gusts; }
+  void set_time(double t) {
+    if (gusts_.changes()) v_air_ = gusts_.at(t);
+  }
+  // 1/2 M top^2 [J]: the kinetic energy of a mass M [kg] carried along at the flow's top speed,
+  // what the flow can give a body (ForceEffect::energy_scale).
+  double carried_energy(double mass) const {
+    const double top = std::max(v_air_.norm(), gusts_.top_speed());
+    return 0.5 * mass * top * top;
+  }
+
+ private:
+  Vec3 v_air_;  // [m/s]
+  Wind gusts_;  // how it changes in time, if it does
+};
+
 }  // namespace clothlab

@@ -1,12 +1,12 @@
-#include "clothlab/core/game_loop.hpp"
+#include "scene/simulation.hpp"
 
 #include <cmath>
 #include <stdexcept>
 
 #include <fmt/format.h>
 
+#include "clothlab/bodies/normals.hpp"
 #include "clothlab/forces/aerodynamics.hpp"
-#include "io/mesh_export.hpp"
 
 namespace clothlab {
 
