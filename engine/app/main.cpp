@@ -383,7 +383,7 @@ int main(int argc, char** argv) {
     }
     if (*repair_cmd) {
       const long frames = cut_to_common_frames(repair_dir);
-      fmt::print("{}: every file holds frames 0 to {} ({} frames)\n", repair_dir, frames - 1,
+      fmt::print("{}: every file holds frames 0 to {} ({} frames)\n", shown(repair_dir), frames - 1,
                  frames);
       return 0;
     }
