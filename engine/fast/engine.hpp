@@ -27,6 +27,10 @@
 // (tests/fast/). An effect the engine does not know (buoyancy, gravitation) adds its forces with
 // add_forces, on the engine's layout, in its turn: f is copied across when the layout changes.
 // SPEED.md has the measurements behind each choice.
+//
+// Of an XPBD step it takes the projections only (xpbd_project, in xpbd.cpp): colour by colour
+// of the integrator's constraint colouring, each colour split over the threads, with the bits
+// of the integrator's own loop.
 #pragma once
 
 #include <functional>
