@@ -28,7 +28,11 @@ namespace {
     const double* __restrict ks, const double* __restrict kd, const double* __restrict l0,
     const double* __restrict inv_m, double* __restrict x, Index nx, const double* __restrict old,
     Index no, double h, double* __restrict lambda, bool keep_lambda) {
+  // Not in a WebAssembly module (engine/web/): its SIMD has no gathers, and the link-time
+  // optimiser there reports a hinted loop it does not vectorise.
+#if !defined(__wasm__)
   CLOTHLAB_INDEPENDENT_ITERATIONS
+#endif
   for (size_t c = begin; c < end; ++c) {
     const Index i = ci[c], j = cj[c];
     Vec3 x_i(x[i], x[nx + i], x[2 * nx + i]), x_j(x[j], x[nx + j], x[2 * nx + j]);
@@ -43,7 +47,9 @@ namespace {
     x[2 * nx + j] = x_j.z();
     if (keep_lambda) lambda[c] += delta_lambda;
   }
+#if !defined(__wasm__)
   CLOTHLAB_INDEPENDENT_ITERATIONS_END
+#endif
 }
 
 }  // namespace
