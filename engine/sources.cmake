@@ -48,7 +48,8 @@ set(CLOTHLAB_FAST_SOURCES
   fast/engine.cpp
   fast/forces.cpp
   fast/springs.cpp
-  fast/aerodynamics.cpp)
+  fast/aerodynamics.cpp
+  fast/xpbd.cpp)
 # What only the native program needs: runs, their files and the viewer page.
 set(CLOTHLAB_IO_SOURCES
   io/run.cpp

@@ -16,8 +16,10 @@
 // wall time per simulated second (fastest repeat). A
 // CSV, and a plot per scene drawn by a small matplotlib script written next to it.
 //
-// `--speed`: on a 128 x 128 cloth, what a symplectic Euler step costs per spring against one
-// XPBD projection per spring, measured in the same run.
+// `--speed`: on cloths of 64 x 64, 128 x 128 and 256 x 256 particles, on 1 and 2 threads, what
+// a symplectic Euler step and an XPBD iteration cost per spring, each on the readable path (no
+// backend) and in the engine room (engine/fast/), measured in the same run, and the issue's
+// targets beside the ratios.
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -58,7 +60,7 @@ struct MethodsOptions {
   bool quick = false;
   double min_seconds = 0.05;  // wall time each run is repeated for
   bool speed = false;
-  int grid = 128;  // the speed measurement's cloth: grid x grid particles
+  std::vector<int> grids = {64, 128, 256};  // the speed measurement's cloths: N x N particles
 };
 
 // One setting of one method: its step is one frame over per_frame; substeps and iterations
@@ -326,11 +328,14 @@ std::string speed_scene(int grid, std::string_view method, int substeps, int ite
   return text;
 }
 
-// The fastest of `repeats` wall times [s] of `steps` steps of the scene.
-double time_steps(const std::string& text, int steps, int repeats) {
+// The fastest of `repeats` wall times [s] of `steps` steps of the scene on `threads` threads,
+// in the engine room (`fast`) or on the readable path alone.
+double time_steps(const std::string& text, int steps, int repeats, int threads, bool fast) {
   double best = std::numeric_limits<double>::infinity();
   for (int r = 0; r < repeats; ++r) {
     World world = std::move(parse_scene(text, "<speed>").world);
+    if (!fast) world.backend.reset();
+    world.threads = threads;
     const Clock::time_point start = Clock::now();
     for (int s = 0; s < steps; ++s)
       world.step(1e-4);
@@ -339,35 +344,92 @@ double time_steps(const std::string& text, int steps, int repeats) {
   return best;
 }
 
-void speed(const MethodsOptions& opt, const fs::path& out_dir) {
-  const int grid = opt.grid, steps = opt.quick ? 5 : 40, repeats = opt.quick ? 2 : 5;
-  const Scene scene = parse_scene(speed_scene(grid, "symplectic-euler", 0, 0), "<speed>");
+// One grid's figures on one number of threads [ns per spring].
+struct SpeedRow {
+  int grid = 0, threads = 0;
   size_t springs = 0;
+  double euler[2] = {}, xpbd_one[2] = {}, xpbd_iteration[2] = {};  // [readable, engine room]
+};
+
+SpeedRow measure_speed(int grid, int threads, bool quick) {
+  const int steps = quick ? 5 : 40, repeats = quick ? 2 : 5;
+  SpeedRow row;
+  row.grid = grid;
+  row.threads = threads;
+  const Scene scene = parse_scene(speed_scene(grid, "symplectic-euler", 0, 0), "<speed>");
   for (const auto& effect : scene.world.force_effects) {
     if (const auto* s = dynamic_cast<const SpringDampers*>(effect.get()))
-      springs += s->springs().size();
+      row.springs += s->springs().size();
   }
-  const double per = 1e9 / (static_cast<double>(springs) * steps);  // s per run -> ns per spring
+  const double per = 1e9 / (static_cast<double>(row.springs) * steps);  // s per run -> ns
   constexpr int kMore = 8;  // the extra iterations whose cost is the cost of an iteration
-  const double euler =
-      per * time_steps(speed_scene(grid, "symplectic-euler", 0, 0), steps, repeats);
-  const double one = per * time_steps(speed_scene(grid, "xpbd", 1, 1), steps, repeats);
-  const double many = per * time_steps(speed_scene(grid, "xpbd", 1, 1 + kMore), steps, repeats);
-  const double iteration = (many - one) / kMore;
-  fmt::print("\nspeed: a {0} x {0} cloth, {1} springs, {2} steps, fastest of {3} runs\n", grid,
-             springs, steps, repeats);
-  fmt::print("  symplectic Euler, one step:                   {:8.2f} ns per spring\n", euler);
-  fmt::print("  XPBD, one substep of one iteration:           {:8.2f} ns per spring\n", one);
-  fmt::print("  XPBD, each further iteration (from {:2} vs 1):  {:8.2f} ns per spring\n", 1 + kMore,
-             iteration);
-  fmt::print("  an XPBD iteration costs {:.2f} symplectic Euler steps\n", iteration / euler);
-  std::string table = "grid,springs,measure,ns_per_spring\n";
-  fmt::format_to(std::back_inserter(table), "{0},{1},symplectic-euler-step,{2:.6g}\n", grid,
-                 springs, euler);
-  fmt::format_to(std::back_inserter(table), "{0},{1},xpbd-substep-1-iteration,{2:.6g}\n", grid,
-                 springs, one);
-  fmt::format_to(std::back_inserter(table), "{0},{1},xpbd-iteration,{2:.6g}\n", grid, springs,
-                 iteration);
+  for (int fast = 0; fast < 2; ++fast) {
+    const auto time = [&](const std::string& text) {
+      return per * time_steps(text, steps, repeats, threads, fast == 1);
+    };
+    row.euler[fast] = time(speed_scene(grid, "symplectic-euler", 0, 0));
+    row.xpbd_one[fast] = time(speed_scene(grid, "xpbd", 1, 1));
+    const double many = time(speed_scene(grid, "xpbd", 1, 1 + kMore));
+    row.xpbd_iteration[fast] = (many - row.xpbd_one[fast]) / kMore;
+  }
+  return row;
+}
+
+void speed(const MethodsOptions& opt, const fs::path& out_dir) {
+  std::vector<SpeedRow> rows;
+  fmt::print(
+      "\nspeed: ns per spring, fastest of {} runs of {} steps; readable = the lecture's "
+      "code alone, engine room = engine/fast/\n",
+      opt.quick ? 2 : 5, opt.quick ? 5 : 40);
+  fmt::print("  {:>9} {:>7} {:>7} | {:>21} | {:>21} | {:>21} | {:>14}\n", "grid", "springs",
+             "threads", "symplectic Euler step", "XPBD substep, 1 it.", "XPBD iteration",
+             "XPBD it./step");
+  fmt::print("  {:>9} {:>7} {:>7} | {:>10} {:>10} | {:>10} {:>10} | {:>10} {:>10} | {:>14}\n", "",
+             "", "", "readable", "engine", "readable", "engine", "readable", "engine",
+             "engine (<=1.5)");
+  for (int grid : opt.grids) {
+    for (int threads : {1, 2}) {
+      const SpeedRow r = measure_speed(grid, threads, opt.quick);
+      fmt::print(
+          "  {:>9} {:>7} {:>7} | {:10.2f} {:10.2f} | {:10.2f} {:10.2f} | {:10.2f} {:10.2f} | "
+          "{:14.2f}\n",
+          fmt::format("{0} x {0}", grid), r.springs, threads, r.euler[0], r.euler[1], r.xpbd_one[0],
+          r.xpbd_one[1], r.xpbd_iteration[0], r.xpbd_iteration[1],
+          r.xpbd_iteration[1] / r.euler[1]);
+      rows.push_back(r);
+    }
+  }
+  // The targets, as ratios measured in this run.
+  fmt::print(
+      "  targets (one thread, engine room): an XPBD iteration <= 1.5 symplectic Euler "
+      "steps; 2 threads >= 1.7 times 1 thread at 128 x 128\n");
+  for (const SpeedRow& one : rows) {
+    if (one.threads != 1) continue;
+    const double ratio = one.xpbd_iteration[1] / one.euler[1];
+    fmt::print("  {0} x {0}: XPBD iteration / Euler step = {1:.2f} ({2})", one.grid, ratio,
+               ratio <= 1.5 ? "met" : "missed");
+    for (const SpeedRow& two : rows) {
+      if (two.grid != one.grid || two.threads != 2) continue;
+      const double euler = one.euler[1] / two.euler[1],
+                   xpbd = one.xpbd_iteration[1] / two.xpbd_iteration[1];
+      fmt::print("; 2 threads over 1: Euler {:.2f}, XPBD {:.2f}{}", euler, xpbd,
+                 one.grid == 128 ? (euler >= 1.7 && xpbd >= 1.7 ? " (met)" : " (missed)") : "");
+    }
+    fmt::print("\n");
+  }
+  std::string table = "grid,springs,measure,ns_per_spring,threads\n";
+  for (const SpeedRow& r : rows) {
+    for (int fast = 0; fast < 2; ++fast) {
+      const char* way = fast ? "" : "-readable";
+      const auto add = [&](const char* measure, double ns) {
+        fmt::format_to(std::back_inserter(table), "{},{},{}{},{:.6g},{}\n", r.grid, r.springs,
+                       measure, way, ns, r.threads);
+      };
+      add("symplectic-euler-step", r.euler[fast]);
+      add("xpbd-substep-1-iteration", r.xpbd_one[fast]);
+      add("xpbd-iteration", r.xpbd_iteration[fast]);
+    }
+  }
   write_whole_file(out_dir / "speed.csv", table);
   fmt::print("  wrote {}\n", (out_dir / "speed.csv").string());
 }
@@ -444,8 +506,11 @@ void add_bench_methods_command(CLI::App& bench) {
       ->check(CLI::PositiveNumber)
       ->capture_default_str();
   methods->add_flag("--speed", options.speed,
-                    "Also time a symplectic Euler step and an XPBD iteration per spring");
-  methods->add_option("--grid", options.grid, "The speed measurement's cloth: N x N particles")
+                    "Also time a symplectic Euler step and an XPBD iteration per spring, readable "
+                    "and engine room, on 1 and 2 threads");
+  methods
+      ->add_option("--grid", options.grids,
+                   "The speed measurement's cloths: N x N particles (one or more N)")
       ->check(CLI::Range(4, 1024))
       ->capture_default_str();
   methods->callback([] { run_bench_command("methods", [] { return bench_methods(options); }); });

@@ -27,6 +27,10 @@
 // (tests/fast/). An effect the engine does not know (buoyancy, gravitation) adds its forces with
 // add_forces, on the engine's layout, in its turn: f is copied across when the layout changes.
 // SPEED.md has the measurements behind each choice.
+//
+// Of an XPBD step it takes the projections only (xpbd_project, in xpbd.cpp): colour by colour
+// of the integrator's constraint colouring, each colour split over the threads, with the bits
+// of the integrator's own loop.
 #pragma once
 
 #include <functional>
@@ -64,8 +68,16 @@ class FastEngine final : public Backend {
   // gives the same bits; it sets only how much of the cloth each pass keeps in the cache.
   Index pass_block = kPassBlock;
 
+  // XPBD's projections colour by colour (xpbd.cpp): fewer constraints in a colour than this
+  // are projected on one thread, where waking the others would cost more than they save. Any
+  // value gives the same bits.
+  Index xpbd_split = 2048;
+
   bool sum_forces(const World& world, const Matrix3X& x, const Matrix3X& v, Matrix3X& f) override;
   BackendStep step(World& world, double dt) override;
+  bool xpbd_project(World& world, const XpbdConstraints& constraints, const Matrix3X& x_old,
+                    double h, int iterations, bool keep_lambda,
+                    std::vector<double>& lambda) override;
 
   // Which of the world's force effects it summed itself in its last evaluation ("gravity+
   // springs+ buoyancy-"), for tests and for `clothlab bench`.
@@ -111,6 +123,7 @@ class FastEngine final : public Backend {
   };
   std::vector<Contact> contacts_;
   Copies copies_;
+  SoA3 xpbd_x_, xpbd_old_;  // x and x_old in the fast layout, for XPBD's projections
 };
 
 // A world's fast engine: what a scene installs as World::backend.

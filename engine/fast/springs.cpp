@@ -35,6 +35,7 @@
 #include <cstring>
 
 #include "fast/forces.hpp"
+#include "fast/vectorise.hpp"
 
 namespace clothlab::fast {
 namespace {
@@ -125,19 +126,8 @@ template <bool Uniform, bool UpperIsJ, bool ToUpper, bool ToLower>
     const double* __restrict x2, const double* __restrict v1, const double* __restrict v2,
     const double* __restrict ks, const double* __restrict kd, const double* __restrict l0,
     double* f_upper, double* f_lower) {
-  // No two springs the compiler takes at once touch the same particle (see kDirectGap). Clang
-  // says so when it cannot vectorise the loop anyway, which is the case whenever the kernel is
-  // not inlined (a build without link-time optimisation): no reason for a warning. A
-  // WebAssembly module without SIMD (engine/web/) has nothing to vectorise with, and there the
-  // link-time optimiser would say so past the pragma below: no hint at all.
-#if defined(__wasm__) && !defined(__wasm_simd128__)
-#elif defined(__clang__)
-#pragma clang diagnostic push
-#pragma clang diagnostic ignored "-Wpass-failed"
-#pragma clang loop vectorize(assume_safety)
-#elif defined(__GNUC__)
-#pragma GCC ivdep
-#endif
+  // No two springs the compiler takes at once touch the same particle (see kDirectGap).
+  CLOTHLAB_INDEPENDENT_ITERATIONS
   for (Index t = 0; t < count; ++t) {
     const Vec3 f1 = spring_damper_force(
         Vec3(x1[t], x1[nx + t], x1[2 * nx + t]), Vec3(x2[t], x2[nx + t], x2[2 * nx + t]),
@@ -158,9 +148,7 @@ template <bool Uniform, bool UpperIsJ, bool ToUpper, bool ToLower>
       f_j[2 * n + t] -= f1.z();
     }
   }
-#if defined(__clang__) && !(defined(__wasm__) && !defined(__wasm_simd128__))
-#pragma clang diagnostic pop
-#endif
+  CLOTHLAB_INDEPENDENT_ITERATIONS_END
 }
 
 // f[c][t] += f1[c][t] (add) or -= (subtract), for t = 0 .. count - 1 and each component c;

@@ -359,10 +359,11 @@ TEST_CASE("xpbd: a pinned corner stays put and a storm tears the sheet") {
   CHECK(test::springs_of(scene.world).size() < springs_before);
 }
 
-TEST_CASE("xpbd: the fast path leaves the step to the readable code, with the same result") {
+TEST_CASE("xpbd: the fast path takes no whole step and no force sum, with the same result") {
   // FastEngine takes whole steps for the Euler methods only; an XPBD step sums its external
-  // forces effect by effect itself. With and without the backend: the same state, bit for bit,
-  // and the backend took no step and no force sum.
+  // forces effect by effect itself, and leaves only its projections to the backend (tests/fast/
+  // checks those). With and without the backend: the same state, bit for bit, and the backend
+  // took no step and no force sum.
   test::check_fast_path_declines(test::storm() + "method = \"xpbd\"\n");
 }
 

@@ -21,6 +21,7 @@
 #include "clothlab/forces/aerodynamics.hpp"
 #include "clothlab/forces/bending.hpp"
 #include "clothlab/forces/spring_damper.hpp"
+#include "clothlab/integrators/xpbd.hpp"
 #include "fast/aerodynamics.hpp"
 #include "fast/engine.hpp"
 #include "fast/springs.hpp"
@@ -797,4 +798,126 @@ TEST_CASE("fast path: a thread team runs every job once and passes on what a job
                   std::runtime_error);
   team.run([&](int t) { sum += t; });  // still usable
   CHECK(sum == 100 * 6 + 3);
+}
+
+namespace {
+
+// Checks that `colour` colours the graph of constraints (i[k], j[k]) properly and greedily: no
+// two constraints sharing a particle share a colour, and each constraint has the smallest colour
+// that no earlier constraint at its ends has.
+void check_greedy_colouring(Index particles, const std::vector<Index>& i,
+                            const std::vector<Index>& j, const std::vector<int>& colour) {
+  REQUIRE(colour.size() == i.size());
+  std::vector<std::set<int>> at(static_cast<size_t>(particles));
+  for (size_t k = 0; k < i.size(); ++k) {
+    CAPTURE(k);
+    std::set<int> taken = at[static_cast<size_t>(i[k])];
+    taken.insert(at[static_cast<size_t>(j[k])].begin(), at[static_cast<size_t>(j[k])].end());
+    int smallest = 0;
+    while (taken.count(smallest))
+      ++smallest;
+    REQUIRE(colour[k] == smallest);
+    at[static_cast<size_t>(i[k])].insert(colour[k]);
+    at[static_cast<size_t>(j[k])].insert(colour[k]);
+  }
+}
+
+}  // namespace
+
+TEST_CASE("fast path: XPBD's colouring is greedy and proper, and a grid needs few colours") {
+  // A random graph, and a star of 150 constraints at one particle: more than one 64-bit word of
+  // colours at a particle.
+  std::mt19937 random(42);
+  std::uniform_int_distribution<Index> particle(0, 59);
+  std::vector<Index> i, j;
+  for (int k = 0; k < 600; ++k) {
+    i.push_back(particle(random));
+    j.push_back(particle(random));
+  }
+  for (Index k = 0; k < 150; ++k) {
+    i.push_back(7);
+    j.push_back(100 + k);
+  }
+  std::vector<int> colour;
+  const int colours = clothlab::xpbd_colouring(250, i, j, colour);
+  check_greedy_colouring(250, i, j, colour);
+  CHECK(colours == *std::max_element(colour.begin(), colour.end()) + 1);
+  CHECK(colours >= 150);
+
+  // A cloth's constraints, in projection order: colour by colour, every spring with ks > 0 once,
+  // no two of a colour at one particle, each colour in the order of the springs.
+  clothlab::Scene scene = clothlab::parse_scene(cloth("", "xpbd"), "colours.toml");
+  scene.world.step(scene.dt);
+  const auto& xpbd = dynamic_cast<const clothlab::Xpbd&>(*scene.world.integrator);
+  const clothlab::XpbdConstraints& cs = xpbd.constraints();
+  size_t springs = 0;
+  for (const char* name : {"springs", "bending"})
+    springs += spring_effect(scene.world, name)->springs().size();
+  CHECK(cs.size() == springs);
+  std::set<std::pair<const clothlab::SpringSet*, size_t>> seen;
+  for (int q = 0; q < cs.colours(); ++q) {
+    CAPTURE(q);
+    std::set<Index> ends;
+    for (size_t c = cs.colour_start[static_cast<size_t>(q)];
+         c < cs.colour_start[static_cast<size_t>(q) + 1]; ++c) {
+      CHECK(ends.insert(cs.i[c]).second);
+      CHECK(ends.insert(cs.j[c]).second);
+      CHECK(seen.insert({cs.set[c], cs.k[c]}).second);
+      CHECK(cs.i[c] == cs.set[c]->i(cs.k[c]));
+      CHECK(cs.l0[c] == cs.set[c]->l0(cs.k[c]));
+    }
+  }
+  CHECK(seen.size() == springs);
+  // Structural, shear and bending springs of a grid: a dozen colours or so, not hundreds.
+  MESSAGE(cs.colours() << " colours for " << cs.size() << " constraints");
+  CHECK(cs.colours() <= 16);
+}
+
+TEST_CASE("fast path: XPBD's projections in the engine room give the readable bits, 1-4 threads") {
+  const std::string text = cloth("[integrator]\n", "xpbd", 30, 28);
+  // Dampers, pins, wind, buoyancy and the ground every substep; 4 substeps of 2 iterations.
+  std::string scene_text = text;
+  scene_text.replace(scene_text.find("dt = 0.0005"), 11,
+                     "dt = 0.004\nsubsteps = 4\niterations = 2");
+  scene_text.erase(scene_text.rfind("[integrator]\n"));
+  const int steps = 60;
+  const clothlab::Scene readable = run(scene_text, false, 1, steps);
+  const auto& readable_xpbd = dynamic_cast<const clothlab::Xpbd&>(*readable.world.integrator);
+  CHECK(readable_xpbd.backend_substeps == 0);
+  CHECK((readable.world.particles.x - clothlab::parse_scene(scene_text, "t").world.particles.x)
+            .cwiseAbs()
+            .maxCoeff() > 1e-3);  // the cloth moved
+  for (int threads = 1; threads <= 4; ++threads) {
+    for (Index split : {Index{1}, clothlab::Index{2048}}) {
+      CAPTURE(threads);
+      CAPTURE(split);
+      const clothlab::Scene fast = run(scene_text, true, threads, steps, [&](clothlab::World& w) {
+        engine_of(w).xpbd_split = split;
+      });
+      // The engine room took every substep's projections: no silent fallback.
+      const auto& xpbd = dynamic_cast<const clothlab::Xpbd&>(*fast.world.integrator);
+      CHECK(xpbd.backend_substeps == steps * xpbd.substeps);
+      CHECK(identical(fast.world.particles.x, readable.world.particles.x));
+      CHECK(identical(fast.world.particles.v, readable.world.particles.v));
+    }
+  }
+}
+
+TEST_CASE("fast path: XPBD with tearing and plasticity recolours and matches the readable path") {
+  std::string text =
+      cloth("[plasticity]\nyield_strain = 0.02\nmax_strain = 0.4\n[tearing]\nstrain = 0.08\n",
+            "xpbd", 24, 24);
+  text.replace(text.find("wind = [3, 0, 2]"), 16, "wind = [0, 0, 60]");
+  text.replace(text.find("dt = 0.0005"), 11, "dt = 0.002\nsubsteps = 2");
+  clothlab::Scene readable = run(text, false, 1, 400);
+  clothlab::Scene threaded =
+      run(text, true, 2, 400, [](clothlab::World& w) { engine_of(w).xpbd_split = 1; });
+  clothlab::Scene built = clothlab::parse_scene(text, "t");
+  REQUIRE(spring_effect(threaded.world, "springs")->springs().size() <
+          spring_effect(built.world, "springs")->springs().size());  // springs tore
+  CHECK(identical(threaded.world.particles.x, readable.world.particles.x));
+  CHECK(spring_effect(threaded.world, "springs")->springs().l0() ==
+        spring_effect(readable.world, "springs")->springs().l0());
+  const auto& xpbd = dynamic_cast<const clothlab::Xpbd&>(*threaded.world.integrator);
+  CHECK(xpbd.backend_substeps == 400 * 2);
 }

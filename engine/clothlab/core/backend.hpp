@@ -11,12 +11,14 @@
 
 #include <cstddef>
 #include <string_view>
+#include <vector>
 
 #include "clothlab/core/types.hpp"
 
 namespace clothlab {
 
 class World;
+struct XpbdConstraints;
 
 // What a backend took of a step (Backend::step).
 struct BackendStep {
@@ -41,6 +43,16 @@ class Backend {
 
   // Takes as much of one step of dt [s] as it can (see BackendStep); {} declines it all.
   virtual BackendStep step(World& world, double dt) = 0;
+
+  // XPBD's projections of one substep of h [s] (integrators/xpbd.hpp): `iterations` times,
+  // every constraint of `constraints` in its order, on world.particles.x, the substep having
+  // started at x_old; lambda (one per constraint, 0 on entry) adds up each delta_lambda when
+  // keep_lambda. The same bits as Xpbd::advance's own loop. False: declined, nothing changed.
+  virtual bool xpbd_project(World& /*world*/, const XpbdConstraints& /*constraints*/,
+                            const Matrix3X& /*x_old*/, double /*h*/, int /*iterations*/,
+                            bool /*keep_lambda*/, std::vector<double>& /*lambda*/) {
+    return false;
+  }
 };
 
 }  // namespace clothlab

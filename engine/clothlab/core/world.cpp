@@ -104,6 +104,10 @@ void World::for_particles(const std::function<void(Index begin, Index end)>& ran
   for_ranges(team(), particles.size(), range);
 }
 
+void World::for_items(Index n, const std::function<void(Index begin, Index end)>& range) const {
+  for_ranges(team(), n, range);
+}
+
 void World::compute_forces_readable(const Matrix3X& x, const Matrix3X& v, Matrix3X& f) const {
   f.setZero();
   ++force_evaluations;

@@ -78,6 +78,9 @@ class World {
   // range on one of the `threads` threads: for loops over particles whose iterations are
   // independent (the guard's checks, a backend's passes).
   void for_particles(const std::function<void(Index begin, Index end)>& range) const;
+  // The same for any n items (a backend's loop over independent constraints): contiguous
+  // ranges that cover [0, n) once each, one a thread.
+  void for_items(Index n, const std::function<void(Index begin, Index end)>& range) const;
 
   // Diagnostics of the current state.
   double kinetic_energy() const;    // sum of 1/2 m |v|^2 [J] (pinned particles do not move)

@@ -1,0 +1,27 @@
+// vectorise.hpp: the hint before a loop whose iterations touch no common particle.
+//
+// The compiler cannot see that the particles a loop reads and writes through indices are
+// distinct for distinct iterations (a run of springs kDirectGap or more apart, springs.cpp; the
+// constraints of one colour, xpbd.cpp); CLOTHLAB_INDEPENDENT_ITERATIONS before the loop says so,
+// and CLOTHLAB_INDEPENDENT_ITERATIONS_END after it. Clang says so when it cannot vectorise the
+// loop anyway, which is the case whenever the kernel is not inlined (a build without link-time
+// optimisation): no reason for a warning. A WebAssembly module without SIMD (engine/web/) has
+// nothing to vectorise with, and there the link-time optimiser would say so past the pragma: no
+// hint at all.
+#pragma once
+
+#if defined(__wasm__) && !defined(__wasm_simd128__)
+#define CLOTHLAB_INDEPENDENT_ITERATIONS
+#define CLOTHLAB_INDEPENDENT_ITERATIONS_END
+#elif defined(__clang__)
+#define CLOTHLAB_INDEPENDENT_ITERATIONS                                                  \
+  _Pragma("clang diagnostic push") _Pragma("clang diagnostic ignored \"-Wpass-failed\"") \
+      _Pragma("clang loop vectorize(assume_safety)")
+#define CLOTHLAB_INDEPENDENT_ITERATIONS_END _Pragma("clang diagnostic pop")
+#elif defined(__GNUC__)
+#define CLOTHLAB_INDEPENDENT_ITERATIONS _Pragma("GCC ivdep")
+#define CLOTHLAB_INDEPENDENT_ITERATIONS_END
+#else
+#define CLOTHLAB_INDEPENDENT_ITERATIONS
+#define CLOTHLAB_INDEPENDENT_ITERATIONS_END
+#endif
