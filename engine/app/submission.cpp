@@ -323,8 +323,7 @@ std::vector<std::string> kit_inputs() {
 }
 
 SubmissionBuild build_submission(const std::string& submission_dir, const std::string& scratch_dir,
-                                 double timeout, bool stub_broken_files,
-                                 const Confinement* confinement) {
+                                 double timeout, const Confinement* confinement) {
   const fs::path kit = grade_kit_dir();
   if (!fs::exists(kit / "CMakeLists.txt")) {
     throw std::runtime_error(fmt::format(
@@ -369,7 +368,6 @@ SubmissionBuild build_submission(const std::string& submission_dir, const std::s
 
   // The submission's files over the stubs, file by file.
   const std::vector<ExerciseFile> files = kit_exercises(kit);
-  std::string refused_include;  // the first file that includes what it may not
   for (const ExerciseFile& file : files) {
     std::string why;
     const fs::path found = find_in_submission(from, file.name, why);
@@ -383,11 +381,8 @@ SubmissionBuild build_submission(const std::string& submission_dir, const std::s
     const std::string problem = include_problem(file.name, read_text(found));
     if (problem.empty()) {
       take_file(found, exercises / file.name, file.stub);
-    } else if (stub_broken_files) {
-      result.broken.push_back({file.name, problem});
-      take_file(file.stub, exercises / file.name, file.stub);
     } else {
-      if (refused_include.empty()) refused_include = problem;
+      result.broken.push_back({file.name, problem});
       take_file(file.stub, exercises / file.name, file.stub);
     }
   }
@@ -400,11 +395,6 @@ SubmissionBuild build_submission(const std::string& submission_dir, const std::s
       if (entry.path().extension() == ".cpp" && !known) result.ignored.push_back(name);
     }
   }
-  if (!refused_include.empty()) {
-    result.first_error = refused_include;  // nothing is compiled
-    return result;
-  }
-
   // A binary left from the submission graded before must never be graded for this one.
   const fs::path binary = build / "grade-kernels";
   fs::remove(binary, ec);
@@ -454,10 +444,8 @@ SubmissionBuild build_submission(const std::string& submission_dir, const std::s
   for (const std::string& arg : {std::string(CLOTHLAB_CMAKE_COMMAND), std::string("--build"),
                                  build.string(), std::string("--parallel"), std::to_string(jobs)})
     args.push_back(arg);
-  if (stub_broken_files) {
-    for (const std::string& arg : keep_going_args())
-      args.push_back(arg);
-  }
+  for (const std::string& arg : keep_going_args())
+    args.push_back(arg);
   // The compiler reads what the submission says: bounded like a case, so that no file it is
   // pointed at can make it take the machine.
   ProcessLimits limits;
@@ -467,10 +455,10 @@ SubmissionBuild build_submission(const std::string& submission_dir, const std::s
   ProcessResult compile = run_process(args, timeout, limits);
   result.log += shown(compile.output);
 
-  // The student's loop: a file that does not compile gives way to its stub, and the build is
-  // tried again, so that the other exercises are graded on what their files say.
+  // A file that does not compile gives way to its stub, and the build is tried again, so that the
+  // other exercises are graded on what their files say.
   const bool failed = compile.exit_code != 0 || compile.signal != 0 || !fs::exists(binary, ec);
-  if (stub_broken_files && failed && !compile.interrupted && !compile.timed_out) {
+  if (failed && !compile.interrupted && !compile.timed_out) {
     for (const ExerciseFile& file : files) {
       if (!compile_failed(compile.output, file.name)) continue;
       std::string error = first_build_error(shown(compile.output), 8, "exercises/" + file.name);
