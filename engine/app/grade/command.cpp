@@ -275,7 +275,8 @@ void grade(const Options& o) {
   if (submission && o.sandbox != "off") grader.sandbox = confinement.kernels(grader.kernels);
   for (std::size_t i = 0; compiled && i < cases.size() && !g_interrupted; ++i) {
     if (cases[i].done) continue;  // not compiled
-    if (colour) fmt::print("\r\033[K[{}/{}] {}", i + 1, cases.size(), cases[i].name.substr(0, 70));
+    if (colour)
+      fmt::print("\r\033[K[{}/{}] {}", i + 1, cases.size(), one_line(cases[i].name).substr(0, 70));
     std::fflush(stdout);
     run_case(grader, cases[i], o.timeout);
     // After every case, so an interrupted run leaves results.
@@ -359,7 +360,7 @@ void watch(Options o) {
     changed.clear();
     for (const auto& file : now) {
       if (std::find(before.begin(), before.end(), file) == before.end())
-        changed += (changed.empty() ? "" : ", ") + file.first;
+        changed += (changed.empty() ? "" : ", ") + one_line(file.first);
     }
     // An editor may write a file in more than one go.
     std::this_thread::sleep_for(std::chrono::milliseconds(150));
