@@ -5,7 +5,8 @@ and reads every report as its reader would.
 What a student sees (results.json's top-level output, which Gradescope shows at once, the outputs
 of the visible tests, and the whole output with --autolab, which Autolab shows) holds nothing of
 a case that is not visible now: no name, hint, message, expected value or points of one, and a
-table whose points are those of the visible cases. The grader's own output and the test entries
+table whose points are those of the visible cases; and the visible cases run first, so that none
+prints what a hidden one left behind. The grader's own output and the test entries
 of the hidden cases keep everything, for the instructor; results.json marks the grader's output
 as the instructor's alone.
 
@@ -21,7 +22,7 @@ import subprocess
 import sys
 import xml.etree.ElementTree as ElementTree
 
-clothlab, cases, work = sys.argv[1], sys.argv[2], pathlib.Path(sys.argv[3])
+clothlab, cases, work = (pathlib.Path(arg).resolve() for arg in sys.argv[1:4])
 shutil.rmtree(work, ignore_errors=True)
 work.mkdir(parents=True)
 problems = []
@@ -32,8 +33,10 @@ def problem(text):
 
 
 def grade(*args):
-    run = subprocess.run([clothlab, "grade", "--binary", cases, "--timeout", "5", *args],
-                         env={"NO_COLOR": "1", "PATH": "/usr/bin:/bin"},
+    # A hidden case leaves a file here, which a visible case prints if it runs later.
+    (work / "left-behind-by-a-hidden-case.txt").unlink(missing_ok=True)
+    run = subprocess.run([clothlab, "grade", "--binary", str(cases), "--timeout", "5", *args],
+                         env={"NO_COLOR": "1", "PATH": "/usr/bin:/bin"}, cwd=work,
                          stdout=subprocess.PIPE, stderr=subprocess.STDOUT, check=False)
     text = run.stdout.decode("utf-8", errors="replace")
     print(f"--- clothlab grade {' '.join(args)}: exit {run.returncode}\n{text}")

@@ -7,6 +7,7 @@
 // report ("Total: 130 / 130 points" after a line break) or that XML 1.0 forbids.
 #include <doctest/doctest.h>
 
+#include <fstream>
 #include <iostream>
 #include <stdexcept>
 #include <string>
@@ -25,6 +26,9 @@ constexpr const char* kNotXml =
     "cut \xe2\x82, return \r, separator \xe2\x80\xa8, reversed \xe2\x80\xae";
 
 constexpr const char* kFakeTotal = "\n\nTotal: 130 / 130 points\n";
+
+// Written by a hidden case in the folder the grader runs in.
+constexpr const char* kLeftBehind = "left-behind-by-a-hidden-case.txt";
 
 }  // namespace
 
@@ -47,8 +51,10 @@ TEST_SUITE("ex93") {
     CHECK(std::string("computed") == std::string("SECRET-EXPECTED-A"));
   }
 
-  // hidden, failed: never shown
+  // hidden, failed: never shown. It leaves a file behind, as kernels without a sandbox could, for
+  // a case run after it to print.
   TEST_CASE("ex93.1 SECRET-NAME-B throws" * POINTS_VISIBILITY(5, hidden)) {
+    std::ofstream(kLeftBehind) << "SECRET-INPUT-B\n";
     throw std::runtime_error("SECRET-MESSAGE-B");
   }
 
@@ -69,8 +75,10 @@ TEST_SUITE("ex94") {
 
 // Each below in an exercise of its own, so that the summary shows its failure in full.
 TEST_SUITE("ex95") {
-  // visible, failed: an exception's text with line breaks
+  // visible, failed: an exception's text with line breaks. It prints what a hidden case left
+  // behind, were that case run before it.
   TEST_CASE("ex95.1 a message with a fake summary" * POINTS(1)) {
+    std::cout << std::ifstream(kLeftBehind).rdbuf() << std::flush;
     throw std::runtime_error(std::string("boom") + kFakeTotal);
   }
 

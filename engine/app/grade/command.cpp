@@ -24,6 +24,7 @@
 #include <filesystem>
 #include <iostream>
 #include <memory>
+#include <numeric>
 #include <string>
 #include <system_error>
 #include <thread>
@@ -273,12 +274,20 @@ void grade(const Options& o) {
     fmt::print("{}", notes);
   }
   if (submission && o.sandbox != "off") grader.sandbox = confinement.kernels(grader.kernels);
-  for (std::size_t i = 0; compiled && i < cases.size() && !g_interrupted; ++i) {
-    if (cases[i].done) continue;  // not compiled
+  // The cases a student sees now run first, so that no output a student sees comes from a run
+  // after a hidden case's: without the sandbox, kernels could keep what a hidden case gave them
+  // (in /tmp, say) and print it in a later case.
+  std::vector<std::size_t> order(cases.size());
+  std::iota(order.begin(), order.end(), std::size_t{0});
+  std::stable_partition(order.begin(), order.end(),
+                        [&](std::size_t i) { return cases[i].visibility == "visible"; });
+  for (std::size_t k = 0; compiled && k < order.size() && !g_interrupted; ++k) {
+    Case& c = cases[order[k]];
+    if (c.done) continue;  // not compiled
     if (colour)
-      fmt::print("\r\033[K[{}/{}] {}", i + 1, cases.size(), one_line(cases[i].name).substr(0, 70));
+      fmt::print("\r\033[K[{}/{}] {}", k + 1, cases.size(), one_line(c.name).substr(0, 70));
     std::fflush(stdout);
-    run_case(grader, cases[i], o.timeout);
+    run_case(grader, c, o.timeout);
     // After every case, so an interrupted run leaves results.
     write_reports(o, cases, elapsed(), notes);
   }
