@@ -244,6 +244,23 @@ bool compile_failed(const std::string& log, const std::string& name) {
   return false;
 }
 
+// The linker's complaint about the exercise file `name`, or "": the line that names it as the
+// file of code that calls what is defined nowhere, or that defines again what another file
+// defines ("03_x.cpp:(.text+0x41): undefined reference to `f()'").
+std::string link_error(const std::string& log, const std::string& name) {
+  std::istringstream in(log);
+  for (std::string line; std::getline(in, line);) {
+    std::size_t at = line.find("undefined reference to");
+    if (at == std::string::npos) at = line.find("multiple definition of");
+    if (at == std::string::npos) continue;
+    const std::string before = line.substr(0, at);
+    if (before.find(name + ":(") != std::string::npos ||
+        before.find("/" + name + ".o") != std::string::npos)
+      return line;
+  }
+  return "";
+}
+
 }  // namespace
 
 std::string build_dir() {
@@ -455,21 +472,33 @@ SubmissionBuild build_submission(const std::string& submission_dir, const std::s
   ProcessResult compile = run_process(args, timeout, limits);
   result.log += shown(compile.output);
 
-  // A file that does not compile gives way to its stub, and the build is tried again, so that the
-  // other exercises are graded on what their files say.
-  const bool failed = compile.exit_code != 0 || compile.signal != 0 || !fs::exists(binary, ec);
-  if (failed && !compile.interrupted && !compile.timed_out) {
+  // A file that does not compile, or that the linker blames, gives way to its stub, and the build
+  // is tried again, so that the other exercises are graded on what their files say. (The link is
+  // tried only once every file compiles, so a round may blame a file the last one did not.)
+  const auto failed = [&] {
+    return compile.exit_code != 0 || compile.signal != 0 || !fs::exists(binary, ec);
+  };
+  while (failed() && !compile.interrupted && !compile.timed_out) {
+    bool blamed = false;
     for (const ExerciseFile& file : files) {
-      if (!compile_failed(compile.output, file.name)) continue;
-      std::string error = first_build_error(shown(compile.output), 8, "exercises/" + file.name);
-      if (error.empty()) error = first_build_error(shown(compile.output));
+      if (std::any_of(result.broken.begin(), result.broken.end(),
+                      [&](const SubmissionBuild::Broken& b) { return b.name == file.name; }))
+        continue;
+      std::string error;
+      if (compile_failed(compile.output, file.name)) {
+        error = first_build_error(shown(compile.output), 8, "exercises/" + file.name);
+        if (error.empty()) error = first_build_error(shown(compile.output));
+      } else {
+        error = link_error(compile.output, file.name);
+      }
+      if (error.empty()) continue;
       result.broken.push_back({file.name, error});
       take_file(file.stub, exercises / file.name, file.stub);
+      blamed = true;
     }
-    if (!result.broken.empty()) {
-      compile = run_process(args, timeout, limits);
-      result.log += shown(compile.output);
-    }
+    if (!blamed) break;
+    compile = run_process(args, timeout, limits);
+    result.log += shown(compile.output);
   }
 
   if (compile.interrupted) {

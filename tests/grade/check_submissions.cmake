@@ -3,8 +3,9 @@
 #   partial  ex01 and ex02 solved, the rest missing: exactly the points of ex01 and ex02
 #   crash    ex01 with a kernel that aborts on one case's input: ex01 loses that case only
 #   hang     ex01 with a kernel that never returns on one case's input: cut off at the timeout
-#   broken   ex01 solved and ex02 with a typo: ex02 reported as not compiling, with the compiler's
-#            error, ex01 graded; the same grade, case by case, as the student's own grading
+#   broken   ex01 solved, ex02 with a typo, ex03 calling what it never defines: ex02 and ex03
+#            reported as not compiling, with the compiler's and the linker's errors, ex01 graded;
+#            the same grade, case by case, as the student's own grading
 # and checks that the user's exercises/ is never touched.
 #
 #   cmake -DCLOTHLAB=<clothlab> -DSOURCE=<project source> -DWORK_DIR=<dir>
@@ -167,14 +168,23 @@ if(took GREATER 120)
   problem("hang: grading took ${took} s, so the loop was not cut off at 3 s")
 endif()
 
-# --- broken: ex01 solved, ex02 with a typo ---------------------------------------------------------
-# The file that does not compile costs its own exercises only: they are reported as not compiled,
-# with the compiler's error, and ex01 is graded as solved. The student's own grading of the same
-# files (--exercises, as `clothlab grade` grades exercises/) gives every case the same result.
+# --- broken: ex01 solved, ex02 with a typo, ex03 that does not link ------------------------------
+# A file that does not compile or link costs its own exercises only: they are reported as not
+# compiled, with the compiler's or the linker's error, and ex01 is graded as solved. The student's
+# own grading of the same files (--exercises, as `clothlab grade` grades exercises/) gives every
+# case the same result.
 file(READ ${SOURCE}/solutions/02_spring_dampers.cpp text)
 string(REGEX REPLACE "return ([^;]*);" "retrun \\1;" broken "${text}")
 file(WRITE ${WORK_DIR}/broken/02_spring_dampers.cpp "${broken}")
 file(COPY ${SOURCE}/solutions/01_particles_and_euler.cpp DESTINATION ${WORK_DIR}/broken)
+# And ex03 compiles but does not link: it calls a function it never defines.
+file(READ ${SOURCE}/solutions/03_aerodynamics.cpp text)
+file(WRITE ${WORK_DIR}/broken/03_aerodynamics.cpp "${text}
+namespace clothlab {
+double helper_never_defined();
+double uses_helper() { return helper_never_defined(); }
+}  // namespace clothlab
+")
 grade_submission(broken ${ex01})
 foreach(text "exercises/02_spring_dampers.cpp does not compile:"
         "exercises/02_spring_dampers.cpp:" "error:")
@@ -191,6 +201,10 @@ case_status(status "${json_broken}"
             "ex02.1 a stretched spring pulls and a compressed one pushes")
 if(NOT status MATCHES "^failed\\|visible\\|not compiled\nexercises/02_spring_dampers.cpp does not compile:\n.*error:")
   problem("broken: an ex02 case is not reported as not compiled with the error: ${status}")
+endif()
+case_status(status "${json_broken}" "ex03.1 air hitting a right triangle head on pushes with 30 N")
+if(NOT status MATCHES "^failed\\|visible\\|not compiled\nexercises/03_aerodynamics.cpp does not compile:\n.*undefined reference")
+  problem("broken: an ex03 case is not reported as not linking, with the linker's error: ${status}")
 endif()
 # What every student sees at once (results.json's top-level output) counts the visible cases
 # alone: ex02.1's row has the points of its visible cases, and no hidden case is named.
