@@ -81,11 +81,12 @@ class ProgressBar {
   std::chrono::steady_clock::time_point last_ = start_;
 };
 
-// Text from a scene or the command line (a title, a key, a path) as a message shows it: control
-// characters in caret notation ("^[" for an escape), as the grader shows a submission's output,
-// newlines and tabs too, so that nothing a scene says can move the cursor or start a line.
+// Text from a scene or the command line (a title, a key, a path) as a message shows it, on one
+// line, as the grader shows a name: control characters in caret notation ("^[" for an escape),
+// a line break or tab as \n or \t, so that nothing a scene says can move the cursor or start a
+// line.
 std::string shown(const std::string& text) {
-  return app::grading::printable(text, /*keep_lines=*/false);
+  return app::grading::one_line(text);
 }
 
 std::string particle_count(const Scene& scene) {

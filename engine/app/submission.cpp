@@ -151,6 +151,23 @@ bool compile_failed(const std::string& log, const std::string& name) {
   return false;
 }
 
+// The linker's complaint about the exercise file `name`, or "": the line that names it as the
+// file of code that calls what is defined nowhere, or that defines again what another file
+// defines ("03_x.cpp:(.text+0x41): undefined reference to `f()'").
+std::string link_error(const std::string& log, const std::string& name) {
+  std::istringstream in(log);
+  for (std::string line; std::getline(in, line);) {
+    std::size_t at = line.find("undefined reference to");
+    if (at == std::string::npos) at = line.find("multiple definition of");
+    if (at == std::string::npos) continue;
+    const std::string before = line.substr(0, at);
+    if (before.find(name + ":(") != std::string::npos ||
+        before.find("/" + name + ".o") != std::string::npos)
+      return line;
+  }
+  return "";
+}
+
 }  // namespace
 
 std::string build_dir() {
@@ -230,8 +247,7 @@ std::vector<std::string> kit_inputs() {
 }
 
 SubmissionBuild build_submission(const std::string& submission_dir, const std::string& scratch_dir,
-                                 double timeout, bool stub_broken_files,
-                                 const Confinement* confinement) {
+                                 double timeout, const Confinement* confinement) {
   const fs::path kit = grade_kit_dir();
   if (!fs::exists(kit / "CMakeLists.txt")) {
     throw std::runtime_error(fmt::format(
@@ -293,7 +309,6 @@ SubmissionBuild build_submission(const std::string& submission_dir, const std::s
 
   // The submission's files over the stubs, file by file.
   const std::vector<ExerciseFile> files = kit_exercises(kit);
-  std::string refused_include;  // the first file that includes what it may not
   for (const ExerciseFile& file : files) {
     std::string why;
     const fs::path found = find_in_submission(from, file.name, why);
@@ -307,11 +322,8 @@ SubmissionBuild build_submission(const std::string& submission_dir, const std::s
     const std::string problem = include_problem(file.name, read_text(found));
     if (problem.empty()) {
       take_file(found, exercises / file.name, file.stub);
-    } else if (stub_broken_files) {
-      result.broken.push_back({file.name, problem});
-      take_file(file.stub, exercises / file.name, file.stub);
     } else {
-      if (refused_include.empty()) refused_include = problem;
+      result.broken.push_back({file.name, problem});
       take_file(file.stub, exercises / file.name, file.stub);
     }
   }
@@ -324,11 +336,6 @@ SubmissionBuild build_submission(const std::string& submission_dir, const std::s
       if (entry.path().extension() == ".cpp" && !known) result.ignored.push_back(name);
     }
   }
-  if (!refused_include.empty()) {
-    result.first_error = refused_include;  // nothing is compiled
-    return result;
-  }
-
   // A binary left from the submission graded before must never be graded for this one.
   const fs::path binary = build / "grade-kernels";
   fs::remove(binary, ec);
@@ -369,10 +376,8 @@ SubmissionBuild build_submission(const std::string& submission_dir, const std::s
   for (const std::string& arg : {std::string(CLOTHLAB_CMAKE_COMMAND), std::string("--build"),
                                  build.string(), std::string("--parallel"), std::to_string(jobs)})
     args.push_back(arg);
-  if (stub_broken_files) {
-    for (const std::string& arg : keep_going_args())
-      args.push_back(arg);
-  }
+  for (const std::string& arg : keep_going_args())
+    args.push_back(arg);
   // The compiler reads what the submission says: bounded like a case, so that no file it is
   // pointed at can make it take the machine.
   ProcessLimits limits;
@@ -382,21 +387,33 @@ SubmissionBuild build_submission(const std::string& submission_dir, const std::s
   ProcessResult compile = run_process(args, timeout, limits);
   result.log += shown(compile.output);
 
-  // The student's loop: a file that does not compile gives way to its stub, and the build is
-  // tried again, so that the other exercises are graded on what their files say.
-  const bool failed = compile.exit_code != 0 || compile.signal != 0 || !fs::exists(binary, ec);
-  if (stub_broken_files && failed && !compile.interrupted && !compile.timed_out) {
+  // A file that does not compile, or that the linker blames, gives way to its stub, and the build
+  // is tried again, so that the other exercises are graded on what their files say. (The link is
+  // tried only once every file compiles, so a round may blame a file the last one did not.)
+  const auto failed = [&] {
+    return compile.exit_code != 0 || compile.signal != 0 || !fs::exists(binary, ec);
+  };
+  while (failed() && !compile.interrupted && !compile.timed_out) {
+    bool blamed = false;
     for (const ExerciseFile& file : files) {
-      if (!compile_failed(compile.output, file.name)) continue;
-      std::string error = first_build_error(shown(compile.output), 8, "exercises/" + file.name);
-      if (error.empty()) error = first_build_error(shown(compile.output));
+      if (std::any_of(result.broken.begin(), result.broken.end(),
+                      [&](const SubmissionBuild::Broken& b) { return b.name == file.name; }))
+        continue;
+      std::string error;
+      if (compile_failed(compile.output, file.name)) {
+        error = first_build_error(shown(compile.output), 8, "exercises/" + file.name);
+        if (error.empty()) error = first_build_error(shown(compile.output));
+      } else {
+        error = link_error(compile.output, file.name);
+      }
+      if (error.empty()) continue;
       result.broken.push_back({file.name, error});
       take_file(file.stub, exercises / file.name, file.stub);
+      blamed = true;
     }
-    if (!result.broken.empty()) {
-      compile = run_process(args, timeout, limits);
-      result.log += shown(compile.output);
-    }
+    if (!blamed) break;
+    compile = run_process(args, timeout, limits);
+    result.log += shown(compile.output);
   }
 
   if (compile.interrupted) {

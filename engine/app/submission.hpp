@@ -27,8 +27,9 @@ struct SubmissionBuild {
   std::vector<std::string> ignored;  // other .cpp files in it, left out
   // Exercise files refused, each with why ("01_x.cpp (a symbolic link)"): graded on the stub.
   std::vector<std::string> refused;
-  // With stub_broken_files: the exercise files that did not compile, each with the compiler's
-  // first error; the binary holds their shipped stubs instead.
+  // The exercise files that did not compile or link, or that include what they may not, each with
+  // the compiler's or the linker's first error (or why it was refused); the binary holds their
+  // shipped stubs instead.
   struct Broken {
     std::string name;   // "01_particles_and_euler.cpp"
     std::string error;  // "exercises/01_particles_and_euler.cpp:12:5: error: ..."
@@ -44,15 +45,17 @@ struct SubmissionBuild {
 // `timeout` seconds. Throws std::runtime_error when the build kit is missing or the submission
 // folder does not exist; a submission that does not compile is not an error but a result.
 // The scratch folder keeps its build, so grading the same files again recompiles only the files
-// that changed. With `stub_broken_files`, an exercise file that does not compile is replaced by
-// its shipped stub, so that the other files' exercises can still be graded (the student's own
-// loop); without it, one such file means no binary (a submission scores zero).
+// that changed. An exercise file that does not compile, that includes what it may not, or that
+// the linker blames (it calls what is defined nowhere, or defines again what another file
+// defines) is replaced by its shipped stub, so that it costs its own exercises only and the other
+// files' exercises are graded on what they say: the student's own loop and a submission's grading
+// are the same build, so the same files get the same grade either way. Only an error no file can
+// be blamed for leaves no binary.
 // With `confinement` (a submission's build), the build runs confined: it sees the system, the
 // kit's inputs (kit_inputs) and the scratch folder alone, and it starts from no object of an
 // earlier build, so nothing compiled from another submission is there to read.
 SubmissionBuild build_submission(const std::string& submission_dir, const std::string& scratch_dir,
-                                 double timeout, bool stub_broken_files = false,
-                                 const Confinement* confinement = nullptr);
+                                 double timeout, const Confinement* confinement = nullptr);
 
 // What a submission's build reads besides the system and its own files: the kit, the engine's
 // headers, and the objects of the project's build it links (grade-kit/inputs.txt).

@@ -47,7 +47,7 @@ dt = 0.1
 duration = 0.2
 ")
 run_clothlab("run" 0 run ${WORK}/title.toml --out "${WORK}/out${esc}[31m")
-foreach(expected "title.toml - a^[[2Jb^Gc^Jerror: fake\n" "/out^[[31m/: energy.csv"
+foreach(expected "title.toml - a^[[2Jb^Gc\\nerror: fake\n" "/out^[[31m/: energy.csv"
                  "/out^[[31m/view.html in a browser")
   expect_text("run" "${out}" "${expected}")
 endforeach()

@@ -27,6 +27,13 @@ endif()
 message("${score}")
 EOF
 score_of() { cmake -DFILE="$1" -P "$work/score.cmake" 2>&1; }
+# The top-level output of a results.json, which Gradescope shows every student.
+cat >"$work/output.cmake" <<'EOF'
+file(READ ${FILE} json)
+string(JSON output GET "${json}" output)
+message("${output}")
+EOF
+output_of() { cmake -DFILE="$1" -P "$work/output.cmake" 2>&1; }
 
 # grade NAME [ARGS...]: grades $work/NAME on ex01, output in $work/NAME.out, score in $score.
 grade() {
@@ -114,6 +121,22 @@ grade escapes
 expect_at_most escapes 12
 if grep -q $'\x1b' "$work/escapes.out"; then problem "escapes: an escape character reached the terminal"; fi
 grep -q '\^\[\[2J' "$work/escapes.out" || problem "escapes: the escape is not shown as ^["
+
+# --- names are data: a file name with line breaks draws no line of a report ---------------------
+mkdir -p "$work/newline-name"
+cp "$solution" "$work/newline-name/$name"
+# (A file name holds no '/': the division slash U+2215 looks the same.)
+fake=$'notes\n\nTotal: 130 \xe2\x88\x95 130 points\n.cpp'
+echo '// not an exercise file' >"$work/newline-name/$fake"
+grade newline-name
+[[ $score == 14 ]] || problem "newline-name: scored $score of 14"
+output_of "$work/newline-name.json" >"$work/newline-name.top"
+for report in "$work/newline-name.out" "$work/newline-name.top"; do
+  totals=$(grep -c '^ *Total:' "$report" || true)
+  [[ $totals == 1 ]] || problem "newline-name: $totals lines read 'Total:' where the report has one"
+done
+grep -qF $'Ignored (not an exercise file): notes\\n\\nTotal: 130 \xe2\x88\x95 130 points\\n.cpp' \
+  "$work/newline-name.out" || problem "newline-name: the file's name is not shown escaped"
 
 # --- an honest, correct submission that prints a lot -------------------------------------------
 mkdir -p "$work/chatty"

@@ -3,7 +3,9 @@
 #   partial  ex01 and ex02 solved, the rest missing: exactly the points of ex01 and ex02
 #   crash    ex01 with a kernel that aborts on one case's input: ex01 loses that case only
 #   hang     ex01 with a kernel that never returns on one case's input: cut off at the timeout
-#   broken   ex02 with a typo: reported as not compiling, with the compiler's error, 0 points
+#   broken   ex01 solved, ex02 with a typo, ex03 calling what it never defines: ex02 and ex03
+#            reported as not compiling, with the compiler's and the linker's errors, ex01 graded;
+#            the same grade, case by case, as the student's own grading
 # and checks that the user's exercises/ is never touched.
 #
 #   cmake -DCLOTHLAB=<clothlab> -DSOURCE=<project source> -DWORK_DIR=<dir>
@@ -166,20 +168,76 @@ if(took GREATER 120)
   problem("hang: grading took ${took} s, so the loop was not cut off at 3 s")
 endif()
 
-# --- broken: does not compile ------------------------------------------------------------------
+# --- broken: ex01 solved, ex02 with a typo, ex03 that does not link ------------------------------
+# A file that does not compile or link costs its own exercises only: they are reported as not
+# compiled, with the compiler's or the linker's error, and ex01 is graded as solved. The student's
+# own grading of the same files (--exercises, as `clothlab grade` grades exercises/) gives every
+# case the same result.
 file(READ ${SOURCE}/solutions/02_spring_dampers.cpp text)
 string(REGEX REPLACE "return ([^;]*);" "retrun \\1;" broken "${text}")
 file(WRITE ${WORK_DIR}/broken/02_spring_dampers.cpp "${broken}")
-grade_submission(broken 0)
-foreach(text "The submission does not compile:" "exercises/02_spring_dampers.cpp:" "error:")
+file(COPY ${SOURCE}/solutions/01_particles_and_euler.cpp DESTINATION ${WORK_DIR}/broken)
+# And ex03 compiles but does not link: it calls a function it never defines.
+file(READ ${SOURCE}/solutions/03_aerodynamics.cpp text)
+file(WRITE ${WORK_DIR}/broken/03_aerodynamics.cpp "${text}
+namespace clothlab {
+double helper_never_defined();
+double uses_helper() { return helper_never_defined(); }
+}  // namespace clothlab
+")
+grade_submission(broken ${ex01})
+foreach(text "exercises/02_spring_dampers.cpp does not compile:"
+        "exercises/02_spring_dampers.cpp:" "error:")
   string(FIND "${out_broken}" "${text}" at)
   if(at EQUAL -1)
     problem("broken: the output does not say \"${text}\"")
   endif()
 endforeach()
 case_status(status "${json_broken}" "ex01.1 gravity on a 2 kg particle is m g")
-if(NOT status MATCHES "^failed\\|visible\\|not compiled\nthe submission does not compile:\n.*error:")
-  problem("broken: a case is not reported as not compiled with the error: ${status}")
+if(NOT status MATCHES "^passed\\|visible\\|")
+  problem("broken: ex01.1, whose file compiles, is not passed beside the broken ex02: ${status}")
+endif()
+case_status(status "${json_broken}"
+            "ex02.1 a stretched spring pulls and a compressed one pushes")
+if(NOT status MATCHES "^failed\\|visible\\|not compiled\nexercises/02_spring_dampers.cpp does not compile:\n.*error:")
+  problem("broken: an ex02 case is not reported as not compiled with the error: ${status}")
+endif()
+case_status(status "${json_broken}" "ex03.1 air hitting a right triangle head on pushes with 30 N")
+if(NOT status MATCHES "^failed\\|visible\\|not compiled\nexercises/03_aerodynamics.cpp does not compile:\n.*undefined reference")
+  problem("broken: an ex03 case is not reported as not linking, with the linker's error: ${status}")
+endif()
+# What every student sees at once (results.json's top-level output) counts the visible cases
+# alone: ex02.1's row has the points of its visible cases, and no hidden case is named.
+points_of(ex02_1_visible "^ex02\\.1 .*  visible$")
+string(JSON top GET "${json_broken}" output)
+if(NOT top MATCHES "\nex02\\.1 +0 / ${ex02_1_visible} " OR top MATCHES "hidden:")
+  problem("broken: the top-level output counts or names hidden cases:\n${top}")
+endif()
+# The same files graded as the student's own.
+execute_process(
+  COMMAND ${CMAKE_COMMAND} -E env NO_COLOR=1 ${CLOTHLAB} grade --exercises ${WORK_DIR}/broken
+          --scratch ${WORK_DIR}/own-scratch --results ${WORK_DIR}/broken-own.json --hidden
+  RESULT_VARIABLE code OUTPUT_VARIABLE out ERROR_VARIABLE err)
+message("--- broken, graded as the student's own: exit ${code}\n${out}${err}")
+file(READ ${WORK_DIR}/broken-own.json json_own)
+string(JSON count_own LENGTH "${json_own}" tests)
+string(JSON count LENGTH "${json_broken}" tests)
+if(NOT code EQUAL 0 OR NOT count EQUAL count_own)
+  problem("broken: graded as the student's own, exit ${code} and ${count_own} cases, where "
+          "--submission graded ${count}")
+else()
+  math(EXPR last "${count} - 1")
+  foreach(i RANGE ${last})
+    foreach(key name status score max_score visibility output)
+      string(JSON submitted GET "${json_broken}" tests ${i} ${key})
+      string(JSON own GET "${json_own}" tests ${i} ${key})
+      if(NOT submitted STREQUAL own)
+        string(JSON name GET "${json_broken}" tests ${i} name)
+        problem("broken: \"${name}\" has ${key} \"${submitted}\" with --submission but \"${own}\" "
+                "as the student's own")
+      endif()
+    endforeach()
+  endforeach()
 endif()
 
 # --- the user's tree ---------------------------------------------------------------------------

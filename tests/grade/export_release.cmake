@@ -107,8 +107,9 @@ file(WRITE ${OUT}/run_autograder [=[#!/usr/bin/env bash
 # Gradescope runs this for every submission: it grades the exercise files in
 # /autograder/submission (at its top or in an exercises/ folder; a missing file counts as the
 # shipped stub) and writes /autograder/results/results.json, hidden cases included. Each case
-# runs in its own process with a timeout; a submission that does not compile scores zero with
-# the compiler's error.
+# runs in its own process with a timeout; a file that does not compile costs its own exercises
+# only, with the compiler's error. The summary at the top of results.json, which a student sees at
+# once, shows only the visible cases.
 set -uo pipefail
 root=${AUTOGRADER_ROOT:-/autograder}
 mkdir -p "$root/results"

@@ -130,6 +130,10 @@ void judge(Case& c, const ProcessResult& run, const Grader& grader, double timeo
     // The fewest fields each event has, so that a line cut short cannot crash the grader.
     const std::size_t fields = e[0] == "fail" ? 6 : e[0] == "note" ? 4 : 3;
     if (e.size() < fields) e.resize(fields);
+    // Each field is data (a file name, an expression, a value, a hint, an exception's text): shown
+    // on one line, within the lines the grader lays out.
+    for (std::size_t i = 1; i < e.size(); ++i)
+      e[i] = one_line(e[i]);
     if (e[0] == "start") {
       ++starts;
     } else if (e[0] == "fail" || e[0] == "exception") {
@@ -172,8 +176,8 @@ void judge(Case& c, const ProcessResult& run, const Grader& grader, double timeo
     if (*sig.hint != '\0') c.message += fmt::format("\n{}", sig.hint);
   } else if (starts == 0) {
     c.status = "failed: no test case ran";
-    c.message =
-        "the binary ran no case named \"" + c.name + "\" (it was listed, so this is never a pass)";
+    c.message = "the binary ran no case named \"" + one_line(c.name) +
+                "\" (it was listed, so this is never a pass)";
   } else if (starts > 1) {
     c.status = fmt::format("failed: the name matched {} cases", starts);
     c.message = "rename the case: its name must select it alone";
@@ -194,8 +198,8 @@ void judge(Case& c, const ProcessResult& run, const Grader& grader, double timeo
       c.message = fmt::format("the test program exited with code {}", run.exit_code);
   }
   if (run.timed_out || run.signal != 0 || !crash.empty() || kernels_sig != 0) {
-    c.message +=
-        fmt::format("\nto run this case alone: {} --test-case=\"{}\"", grader.command(), c.name);
+    c.message += fmt::format("\nto run this case alone: {} --test-case=\"{}\"", grader.command(),
+                             one_line(c.name));
   }
   // One line: the first hint when the status alone does not say what went wrong.
   const std::string line = (c.passed || c.not_started) ? ""
@@ -227,13 +231,14 @@ std::vector<Case> list_cases(const std::string& binary) {
     Case c;
     c.suite = e[1];
     c.name = e[2];
-    c.file = relative_path(e[3]);
+    // The name stays as it is, to select the case by; a report shows it with one_line.
+    c.file = one_line(relative_path(e[3]));
     c.line = std::atoi(e[4].c_str());
-    c.exercise = exercise_of(c.name, c.suite);
+    c.exercise = one_line(exercise_of(c.name, c.suite));
     if (e[5].empty()) {
       std::cerr << fmt::format(
           "clothlab grade: warning: {}:{}: case \"{}\" has no POINTS(n): it counts 0 points\n",
-          c.file, c.line, c.name);
+          c.file, c.line, one_line(c.name));
     }
     c.points = std::atoi(e[5].c_str());
     // A hidden test (tests/grade-hidden/) shows on Gradescope once the due date has passed,
@@ -248,7 +253,7 @@ std::vector<Case> list_cases(const std::string& binary) {
       fail(kExitBadInput,
            fmt::format("{}:{}: case \"{}\" has visibility \"{}\"; expected visible, hidden, "
                        "after_due_date or after_published",
-                       c.file, c.line, c.name, c.visibility));
+                       c.file, c.line, one_line(c.name), one_line(c.visibility)));
     }
     cases.push_back(c);
   }

@@ -18,6 +18,8 @@ namespace clothlab::app::grading {
 
 // One grading test case: what the listing says, then how its run went.
 struct Case {
+  // As the binary lists them; the name stays as it is, to select the case by, and a report shows
+  // it with one_line (text.hpp), as file and exercise already are.
   std::string suite, name, file, exercise;
   int line = 0;
   int points = 0;

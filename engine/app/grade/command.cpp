@@ -24,6 +24,7 @@
 #include <filesystem>
 #include <iostream>
 #include <memory>
+#include <numeric>
 #include <string>
 #include <system_error>
 #include <thread>
@@ -77,24 +78,31 @@ bool selected(const Case& c, const std::string& filter) {
   return filter.empty() || c.exercise == filter || c.exercise.starts_with(filter + ".");
 }
 
-// What the build of a submission took, left out and said, for the report.
-std::string submission_notes(const SubmissionBuild& b) {
+// What the build of the exercise files took, left out and refused, and why nothing could be
+// built when nothing could, for the report. The names are the submission's choice: each is shown
+// escaped on one line, so that none can draw a line of the report.
+std::string build_notes(const SubmissionBuild& b, bool submission) {
   auto names = [](const std::vector<std::string>& files) {
     std::string s;
     for (const std::string& f : files) {
       if (!s.empty()) s += ", ";
-      s += printable(f);  // names the submission chose
+      s += one_line(f);
     }
     return s;
   };
   std::string s;
-  if (!b.taken.empty()) s += "Graded from the submission: " + names(b.taken) + "\n";
-  if (!b.missing.empty())
-    s += "Not in the submission (graded on the shipped stub): " + names(b.missing) + "\n";
-  if (!b.ignored.empty()) s += "Ignored (not an exercise file): " + names(b.ignored) + "\n";
+  if (submission) {
+    if (!b.taken.empty()) s += "Graded from the submission: " + names(b.taken) + "\n";
+    if (!b.missing.empty())
+      s += "Not in the submission (graded on the shipped stub): " + names(b.missing) + "\n";
+    if (!b.ignored.empty()) s += "Ignored (not an exercise file): " + names(b.ignored) + "\n";
+  }
   if (!b.refused.empty()) s += "Refused (graded on the shipped stub): " + names(b.refused) + "\n";
-  if (!b.built) s += "\nThe submission does not compile:\n" + indent(b.first_error, "  ") + "\n";
-  return s + "\n";
+  if (!b.built) {
+    s += submission ? "\nThe submission does not compile:\n" : "Your exercises do not build:\n";
+    s += indent(b.first_error, "  ") + "\n";
+  }
+  return s.empty() ? s : s + "\n";
 }
 
 std::string default_scratch() {
@@ -112,7 +120,7 @@ void mark_not_compiled(Case& c, const std::string& what, const std::string& erro
   c.done = true;
   c.not_compiled = true;
   c.status = "not compiled";
-  c.message = what + ":\n" + error;
+  c.message = what + ":\n" + indent(error, "  ");
   c.diagnosis = error.substr(0, error.find('\n'));
 }
 
@@ -122,32 +130,37 @@ bool in_file(const Case& c, const std::string& file) {
   return c.exercise == lesson || c.exercise.starts_with(lesson + ".");
 }
 
-// The student's own grading: exercises/ built afresh with the kit (only what changed is
-// recompiled), a file that does not compile standing aside for its stub. Returns the binary to
-// grade, or "" when nothing could be built; marks the cases that cannot be graded.
-std::string build_own(const Options& o, std::vector<Case>& cases, std::string& notes, bool colour,
-                      std::shared_ptr<void>& hold) {
-  const std::string dir =
-      o.exercises.empty() ? (fs::path(CLOTHLAB_SOURCE_DIR) / "exercises").string() : o.exercises;
-  if (colour) fmt::print("building your exercises ...");
+// Builds the kernels program of the exercise files in `dir`, in `scratch`, by the one code path
+// both gradings take: the student's own (exercises/ is `dir`) and a submission's (`submission`,
+// as run_autograder grades), so that the same files get the same grade either way. A file that
+// does not compile, or includes what it may not, gives way to its shipped stub and costs its own
+// exercises only: they are marked not compiled, with its error, and the others are graded.
+// Returns the kernels program, or "" when nothing could be built (every case is then marked, but
+// when the grader was interrupted); `notes` gets what the build said.
+std::string build_kernels(const std::string& dir, const std::string& scratch, bool submission,
+                          const Options& o, const Confinement* confinement,
+                          std::vector<Case>& cases, std::string& notes, bool colour,
+                          std::shared_ptr<void>& hold) {
+  if (colour)
+    fmt::print("building {} ...", submission ? one_line(dir) : std::string("your exercises"));
   std::fflush(stdout);
   SubmissionBuild build;
   try {
-    build =
-        build_submission(dir, o.scratch.empty() ? own_scratch() : o.scratch, o.build_timeout, true);
+    build = build_submission(dir, scratch, o.build_timeout, confinement);
   } catch (const std::exception& e) {
     fail(kExitBadInput, e.what());
   }
   if (colour) fmt::print("\r\033[K");
   hold = build.hold;  // the scratch folder stays this grader's while the binary is graded
-  for (const std::string& why : build.refused)
-    notes += "Refused, graded on its shipped stub: exercises/" + printable(why) + "\n";
+  build.first_error = printable(build.first_error);
+  notes += build_notes(build, submission);
   if (!build.built) {
     if (g_interrupted) return "";
-    build.first_error = printable(build.first_error);
-    notes += "Your exercises do not build:\n" + indent(build.first_error, "  ") + "\n\n";
-    for (Case& c : cases)
-      mark_not_compiled(c, "the exercises do not build", build.first_error);
+    for (Case& c : cases) {
+      mark_not_compiled(
+          c, submission ? "the submission does not compile" : "your exercises do not build",
+          build.first_error);
+    }
     return "";
   }
   for (SubmissionBuild::Broken& broken : build.broken) {
@@ -165,8 +178,7 @@ std::string build_own(const Options& o, std::vector<Case>& cases, std::string& n
 // top of Gradescope's results.
 void write_reports(const Options& o, const std::vector<Case>& cases, double seconds,
                    const std::string& notes) {
-  if (!o.results.empty())
-    write_file(o.results, gradescope_json(cases, seconds, notes + summary(cases, false)));
+  if (!o.results.empty()) write_file(o.results, gradescope_json(cases, seconds, notes));
   if (!o.junit.empty()) write_file(o.junit, junit_xml(cases, seconds));
 }
 
@@ -262,50 +274,47 @@ void grade(const Options& o) {
     // What holds the hidden tests is root's alone, wherever the submission's code runs.
     if (geteuid() == 0) keep_hidden_tests_to_owner(build_dir(), CLOTHLAB_SOURCE_DIR);
   }
-  if (submission) {
-    notes = "Submission: " + o.submission + "\n";
-    write_reports(o, cases, elapsed(), notes);  // so even an interrupted build leaves results
-    if (colour) fmt::print("building {} ...", o.submission);
-    std::fflush(stdout);
-    SubmissionBuild build;
-    try {
-      build = build_submission(o.submission, o.scratch.empty() ? default_scratch() : o.scratch,
-                               o.build_timeout, false, &confinement);
-    } catch (const std::exception& e) {
-      fail(kExitBadInput, e.what());
+  if (submission || own) {
+    if (submission) {
+      notes = "Submission: " + one_line(o.submission) + "\n";
+      write_reports(o, cases, elapsed(), notes);  // so even an interrupted build leaves results
     }
-    if (colour) fmt::print("\r\033[K");
-    hold = build.hold;
-    build.first_error = printable(build.first_error);
-    notes += submission_notes(build);
-    fmt::print("{}", notes);
-    compiled = build.built;
-    if (compiled) {
-      grader.kernels = build.binary;
-    } else if (!g_interrupted) {
-      for (Case& c : cases)
-        mark_not_compiled(c, "the submission does not compile", build.first_error);
-    }
-  }
-  if (own) {
-    grader.kernels = build_own(o, cases, notes, colour, hold);
+    const std::string dir = submission ? o.submission
+                            : o.exercises.empty()
+                                ? (fs::path(CLOTHLAB_SOURCE_DIR) / "exercises").string()
+                                : o.exercises;
+    const std::string scratch = !o.scratch.empty() ? o.scratch
+                                : submission       ? default_scratch()
+                                                   : own_scratch();
+    grader.kernels = build_kernels(dir, scratch, submission, o, submission ? &confinement : nullptr,
+                                   cases, notes, colour, hold);
     compiled = !grader.kernels.empty();
     fmt::print("{}", notes);
   }
   if (submission && compiled)
     grader.sandbox = confinement.kernels(built_program("grade-confine"), grader.kernels);
-  for (std::size_t i = 0; compiled && i < cases.size() && !g_interrupted; ++i) {
-    if (cases[i].done) continue;  // not compiled
-    if (colour) fmt::print("\r\033[K[{}/{}] {}", i + 1, cases.size(), cases[i].name.substr(0, 70));
+  // The cases a student sees now run first, so that no output a student sees comes from a run
+  // after a hidden case's: without the sandbox, kernels could keep what a hidden case gave them
+  // (in /tmp, say) and print it in a later case.
+  std::vector<std::size_t> order(cases.size());
+  std::iota(order.begin(), order.end(), std::size_t{0});
+  std::stable_partition(order.begin(), order.end(),
+                        [&](std::size_t i) { return cases[i].visibility == "visible"; });
+  for (std::size_t k = 0; compiled && k < order.size() && !g_interrupted; ++k) {
+    Case& c = cases[order[k]];
+    if (c.done) continue;  // not compiled
+    if (colour)
+      fmt::print("\r\033[K[{}/{}] {}", k + 1, cases.size(), one_line(c.name).substr(0, 70));
     std::fflush(stdout);
-    run_case(grader, cases[i], o.timeout);
+    run_case(grader, c, o.timeout);
     // After every case, so an interrupted run leaves results.
     write_reports(o, cases, elapsed(), notes);
   }
   if (colour) fmt::print("\r\033[K");
   std::fflush(stdout);
 
-  fmt::print("{}", summary(cases, colour));
+  // Autolab shows the grader's whole output to the student: then only what a student may see.
+  fmt::print("{}", summary(cases, colour, o.autolab ? Audience::student : Audience::grader));
   write_reports(o, cases, elapsed(), notes);
   if (g_interrupted)
     fail(kExitInterrupted, "interrupted: the results of the cases run so far are written");
@@ -379,7 +388,7 @@ void watch(Options o) {
     changed.clear();
     for (const auto& file : now) {
       if (std::find(before.begin(), before.end(), file) == before.end())
-        changed += (changed.empty() ? "" : ", ") + file.first;
+        changed += (changed.empty() ? "" : ", ") + one_line(file.first);
     }
     // An editor may write a file in more than one go.
     std::this_thread::sleep_for(std::chrono::milliseconds(150));

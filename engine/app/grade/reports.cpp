@@ -41,9 +41,17 @@ std::string json_dump(const Json& json, int indent) {
   return json.dump(indent, ' ', false, Json::error_handler_t::replace);
 }
 
-std::string xml_escape(const std::string& text) {
+// Text made fit for XML 1.0, whose characters are tab, line feed, carriage return, U+0020 to
+// U+D7FF, U+E000 to U+FFFD and U+10000 to U+10FFFF: anything else (invalid UTF-8, a surrogate, an
+// overlong form, a control character, U+FFFE or U+FFFF) becomes "?", even escaped. In an
+// attribute, line breaks and tabs are written as references, which a parser keeps (it turns the
+// characters themselves into spaces).
+std::string xml_escape(const std::string& text, bool attribute = false) {
   std::string out;
-  for (char ch : valid_utf8(text)) {
+  const std::string in = valid_utf8(text);  // well-formed: no surrogate, nothing past U+10FFFF
+  for (std::size_t i = 0; i < in.size(); ++i) {
+    const char ch = in[i];
+    const auto b = static_cast<unsigned char>(ch);
     if (ch == '&') {
       out += "&amp;";
     } else if (ch == '<') {
@@ -52,13 +60,36 @@ std::string xml_escape(const std::string& text) {
       out += "&gt;";
     } else if (ch == '"') {
       out += "&quot;";
-    } else if (static_cast<unsigned char>(ch) < 0x20 && ch != '\n' && ch != '\t') {
-      out += '?';  // XML 1.0 forbids other control characters, even escaped
+    } else if (ch == '\r' || (attribute && (ch == '\n' || ch == '\t'))) {
+      out += fmt::format("&#{};", static_cast<int>(ch));
+    } else if (b < 0x20 && ch != '\n' && ch != '\t') {
+      out += '?';
+    } else if (b == 0xEF && i + 2 < in.size() && in[i + 1] == '\xBF' &&
+               (in[i + 2] == '\xBE' || in[i + 2] == '\xBF')) {
+      out += '?';  // U+FFFE or U+FFFF
+      i += 2;
     } else {
       out += ch;
     }
   }
   return out;
+}
+
+// The cases grouped by exercise, in the order of their first case.
+std::vector<Exercise> group(const std::vector<const Case*>& cases) {
+  std::vector<Exercise> exercises;
+  for (const Case* c : cases) {
+    auto it = std::find_if(exercises.begin(), exercises.end(),
+                           [&](const Exercise& x) { return x.id == c->exercise; });
+    if (it == exercises.end()) it = exercises.insert(exercises.end(), Exercise{c->exercise, {}});
+    it->cases.push_back(c);
+    it->max += c->points;
+    if (c->passed) {
+      it->earned += c->points;
+      ++it->passed;
+    }
+  }
+  return exercises;
 }
 
 // The text a report shows for one case: its status, first failure and own output.
@@ -76,29 +107,21 @@ std::string case_report(const Case& c, bool with_output) {
 }  // namespace
 
 std::vector<Exercise> by_exercise(const std::vector<Case>& cases) {
-  std::vector<Exercise> exercises;
-  for (const Case& c : cases) {
-    auto it = std::find_if(exercises.begin(), exercises.end(),
-                           [&](const Exercise& x) { return x.id == c.exercise; });
-    if (it == exercises.end()) it = exercises.insert(exercises.end(), Exercise{c.exercise, {}});
-    it->cases.push_back(&c);
-    it->max += c.points;
-    if (c.passed) {
-      it->earned += c.points;
-      ++it->passed;
-    }
-  }
-  return exercises;
+  std::vector<const Case*> all;
+  for (const Case& c : cases)
+    all.push_back(&c);
+  return group(all);
 }
 
 void print_points_table(const std::vector<Case>& cases) {
   std::size_t width = 4;
   for (const Case& c : cases)
-    width = std::max(width, c.name.size());
+    width = std::max(width, one_line(c.name).size());
   fmt::print("{:<10} {:<{}} {:>6}  {}\n", "Exercise", "Case", width, "Points", "Visibility");
   int total = 0, hidden = 0;
   for (const Case& c : cases) {
-    fmt::print("{:<10} {:<{}} {:>6}  {}\n", c.exercise, c.name, width, c.points, c.visibility);
+    fmt::print("{:<10} {:<{}} {:>6}  {}\n", c.exercise, one_line(c.name), width, c.points,
+               c.visibility);
     total += c.points;
     hidden += c.visibility == "visible" ? 0 : c.points;
   }
@@ -108,14 +131,18 @@ void print_points_table(const std::vector<Case>& cases) {
                hidden);
 }
 
-std::string summary(const std::vector<Case>& cases, bool colour) {
+std::string summary(const std::vector<Case>& cases, bool colour, Audience audience) {
+  std::vector<const Case*> shown;
+  for (const Case& c : cases) {
+    if (audience == Audience::grader || c.visibility == "visible") shown.push_back(&c);
+  }
   const auto red = fmt::fg(fmt::terminal_color::red);
   const auto green = fmt::fg(fmt::terminal_color::green);
   const auto yellow = fmt::fg(fmt::terminal_color::yellow);
   std::string s = fmt::format("{:<10} {:>9} {:>9}   {}\n", "Exercise", "Points", "Cases", "Status");
   int earned = 0, max = 0;
   std::vector<std::string> shown_errors;  // a file's compile error, once for its exercises
-  for (const Exercise& x : by_exercise(cases)) {
+  for (const Exercise& x : group(shown)) {
     earned += x.earned;
     max += x.max;
     const Case* first = nullptr;
@@ -149,7 +176,7 @@ std::string summary(const std::vector<Case>& cases, bool colour) {
       }
     } else if (first != nullptr && !all_not_started && first->done && !not_compiled) {
       // The first failing case in full: what was computed, what was expected, where to read.
-      s += fmt::format("    {}: {}\n", paint(colour, fmt::emphasis::bold, first->name),
+      s += fmt::format("    {}: {}\n", paint(colour, fmt::emphasis::bold, one_line(first->name)),
                        paint(colour, red, first->status));
       if (!first->message.empty()) s += indent(first->message, "      ") + "\n";
       const std::string hint = lesson_hint(x.id);
@@ -157,7 +184,7 @@ std::string summary(const std::vector<Case>& cases, bool colour) {
       // Every other one in a line: its name and what went wrong.
       for (const Case* c : x.cases) {
         if (c == first || c->passed || !c->done || c->not_compiled) continue;
-        s += fmt::format("    {}: {}{}\n", paint(colour, fmt::emphasis::bold, c->name),
+        s += fmt::format("    {}: {}{}\n", paint(colour, fmt::emphasis::bold, one_line(c->name)),
                          paint(colour, red, c->status),
                          c->diagnosis.empty() ? "" : ": " + c->diagnosis);
       }
@@ -167,6 +194,14 @@ std::string summary(const std::vector<Case>& cases, bool colour) {
   s += '\n';
   s += paint(colour, fmt::emphasis::bold, fmt::format("Total: {} / {} points", earned, max));
   s += '\n';
+  // Of the cases not shown, their number alone: not which, nor their points.
+  const std::size_t not_shown = cases.size() - shown.size();
+  if (not_shown > 0) {
+    s += fmt::format(
+        "{} more case{} graded, not shown here: {} results are shown after the due date, or "
+        "not at all\n",
+        not_shown, not_shown == 1 ? " is" : "s are", not_shown == 1 ? "its" : "their");
+  }
   return s;
 }
 
@@ -218,17 +253,21 @@ void write_file(const std::string& path, const std::string& text) {
 }
 
 std::string gradescope_json(const std::vector<Case>& cases, double seconds,
-                            const std::string& output) {
+                            const std::string& notes) {
   Json json;
   json["score"] = 0;  // set below, and first in the file
   json["execution_time"] = std::round(seconds * 1000) / 1000;
-  json["output"] = valid_utf8(output);
+  // Shown to every student at once: only the cases visible now. (Gradescope itself hides the
+  // total score from a student while a test is hidden.)
+  json["output"] = valid_utf8(notes + summary(cases, false, Audience::student));
+  // What the grader prints (the whole summary) is the instructor's.
+  json["stdout_visibility"] = "hidden";
   json["tests"] = Json::array();
   int score = 0;
   for (const Case& c : cases) {
     score += c.passed ? c.points : 0;
     Json test;
-    test["name"] = valid_utf8(c.name);
+    test["name"] = one_line(c.name);
     test["number"] = valid_utf8(number_of(c.exercise));
     test["score"] = c.passed ? c.points : 0;
     test["max_score"] = c.points;
@@ -251,14 +290,15 @@ std::string junit_xml(const std::vector<Case>& cases, double seconds) {
       time += c->seconds;
       body += fmt::format(
           "    <testcase classname=\"{}\" name=\"{}\" file=\"{}\" line=\"{}\" time=\"{:.3f}\">\n",
-          xml_escape(x.id), xml_escape(c->name), xml_escape(c->file), c->line, c->seconds);
+          xml_escape(x.id, true), xml_escape(one_line(c->name), true), xml_escape(c->file, true),
+          c->line, c->seconds);
       if (!c->passed) {
         const std::string first_line =
             c->status +
             (c->message.empty() ? "" : ": " + c->message.substr(0, c->message.find('\n')));
         body += fmt::format("      <failure message=\"{}\" type=\"{}\">{}</failure>\n",
-                            xml_escape(first_line),
-                            xml_escape(c->status.substr(0, c->status.find(':'))),
+                            xml_escape(first_line, true),
+                            xml_escape(c->status.substr(0, c->status.find(':')), true),
                             xml_escape(case_report(*c, false)));
       }
       if (!c->output.empty())
@@ -270,7 +310,7 @@ std::string junit_xml(const std::vector<Case>& cases, double seconds) {
     suites += fmt::format(
         "  <testsuite name=\"{}\" tests=\"{}\" failures=\"{}\" errors=\"0\" time=\"{:.3f}\">\n{}  "
         "</testsuite>\n",
-        xml_escape(x.id), x.cases.size(), failed, time, body);
+        xml_escape(x.id, true), x.cases.size(), failed, time, body);
   }
   return fmt::format(
       "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n"

@@ -155,7 +155,7 @@ void Xpbd::advance(World& world, double dt) {
     } else {
       const XpbdConstraints& cs = constraints_;
       for (int it = 0; it < iterations; ++it) {
-        if (it > 0) stop_point();  // and between iterations
+        if (it > 0) stop_point();  // a TERM between iterations too
         for (size_t c = 0; c < cs.size(); ++c) {
           const Index i = cs.i[c], j = cs.j[c];
           Vec3 x_i = p.x.col(i), x_j = p.x.col(j);
