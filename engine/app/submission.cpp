@@ -246,6 +246,20 @@ std::vector<std::string> kit_inputs() {
   return inputs;
 }
 
+namespace {
+
+// `error`, with what a tool stopped by SIGXFSZ does not say itself when `output` shows one was:
+// the build wrote past the limit on a file.
+std::string said_file_too_large(const std::string& output, const std::string& error) {
+  if (output.find("File size limit exceeded") == std::string::npos) return error;
+  return fmt::format(
+      "the build wrote a file larger than {} MiB (the limit on any file it writes: a large array "
+      "with an initial value, say, spelt out in the object file)\n{}",
+      kMaxBuildFileBytes >> 20, error);
+}
+
+}  // namespace
+
 SubmissionBuild build_submission(const std::string& submission_dir, const std::string& scratch_dir,
                                  double timeout, const Confinement* confinement) {
   const fs::path kit = grade_kit_dir();
@@ -340,11 +354,12 @@ SubmissionBuild build_submission(const std::string& submission_dir, const std::s
   const fs::path binary = build / "grade-kernels";
   fs::remove(binary, ec);
   // The build alone is the confined user's: the exercise files stay the grader's, who writes them.
-  std::vector<std::string> confined;
-  if (confinement != nullptr) {
-    hand_over(*confinement, build.string());
-    confined = confinement->build(kit_inputs(), scratch.string());
-  }
+  // The student's own build runs unconfined, but in the same minimal environment
+  // (Confinement::build), so that the same files get the same compiler's words either way (its
+  // quotes, for one, follow LANG).
+  if (confinement != nullptr) hand_over(*confinement, build.string());
+  const std::vector<std::string> confined =
+      (confinement != nullptr ? *confinement : Confinement{}).build(kit_inputs(), scratch.string());
 
   const auto shown = [&](const std::string& text) {
     return replace_all(text, exercises.string() + "/", "exercises/");
@@ -407,7 +422,7 @@ SubmissionBuild build_submission(const std::string& submission_dir, const std::s
         error = link_error(compile.output, file.name);
       }
       if (error.empty()) continue;
-      result.broken.push_back({file.name, error});
+      result.broken.push_back({file.name, said_file_too_large(error, error)});
       take_file(file.stub, exercises / file.name, file.stub);
       blamed = true;
     }
@@ -428,13 +443,7 @@ SubmissionBuild build_submission(const std::string& submission_dir, const std::s
     result.built = true;
     result.binary = binary.string();
   }
-  // A tool that wrote past the limit was stopped by SIGXFSZ, which its own words do not say.
-  if (!result.built && compile.output.find("File size limit exceeded") != std::string::npos) {
-    result.first_error = fmt::format(
-        "the build wrote a file larger than {} MiB (the limit on any file it writes: a large "
-        "array with an initial value, say, spelt out in the object file)\n{}",
-        kMaxBuildFileBytes >> 20, result.first_error);
-  }
+  if (!result.built) result.first_error = said_file_too_large(compile.output, result.first_error);
   return result;
 }
 
