@@ -101,13 +101,14 @@
       }
     }
 
-    // A slider changes the motion: the same scene, run twice for 0.3 s, once with the first
-    // slider's number five times larger (or 1 if it is 0).
+    // A slider changes the motion: the same scene, run twice for 0.6 s, once with the first
+    // slider's number five times larger (or 1 if it is 0). (Long enough for lesson 09's jelly
+    // cube, whose springs first bend when it lands, after 0.32 s of free fall.)
     page.load(first.text, first.name);
     page.setRunning(false);
     const sliders = Array.from(document.querySelectorAll('#sliders input'));
     if (sliders.length) {
-      for (let k = 0; k < 18; ++k) page.advance(1 / 60);
+      for (let k = 0; k < 36; ++k) page.advance(1 / 60);
       const plain = page.positions();
       page.load(first.text, first.name);
       page.setRunning(false);
@@ -115,7 +116,7 @@
       const p = page.parameters().find((q) => q.name === name);
       const value = p.value === 0 ? 1 : p.value * 5;
       const changed = page.setParameter(name, value);
-      for (let k = 0; k < 18; ++k) page.advance(1 / 60);
+      for (let k = 0; k < 36; ++k) page.advance(1 / 60);
       const other = page.positions();
       let diff = 0;
       for (let k = 0; k < plain.length; ++k) diff = Math.max(diff, Math.abs(plain[k] - other[k]));
