@@ -23,9 +23,9 @@
 #include <fmt/format.h>
 
 #include "../common/lesson.hpp"
-#include "scene/simulation.hpp"
 #include "clothlab/core/not_implemented.hpp"
 #include "io/viewer.hpp"
+#include "scene/simulation.hpp"
 
 using namespace clothlab;
 using namespace clothlab::lesson;

@@ -9,9 +9,9 @@
 #include <string>
 #include <vector>
 
-#include "scene/simulation.hpp"
 #include "clothlab/core/guard.hpp"
 #include "clothlab/forces/aerodynamics.hpp"
+#include "scene/simulation.hpp"
 
 using clothlab::Index;
 using clothlab::Matrix3X;

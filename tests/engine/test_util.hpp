@@ -13,13 +13,13 @@
 #include <vector>
 
 #include "clothlab/bodies/cloth.hpp"
-#include "scene/simulation.hpp"
 #include "clothlab/core/world.hpp"
 #include "clothlab/forces/gravity.hpp"
 #include "clothlab/forces/spring_damper.hpp"
 #include "clothlab/integrators/euler.hpp"
 #include "clothlab/integrators/integrator.hpp"
 #include "scene/scene.hpp"
+#include "scene/simulation.hpp"
 
 namespace test {
 

@@ -12,25 +12,9 @@
 # - `--sandbox off` refuses to run the code as root unless told twice, and then warns.
 # Each hostile kernel answers right only when the bound held, so it scores 14 exactly then.
 set -euo pipefail
-clothlab=$1
-source_dir=$2
-work=$3
-rm -rf "$work"
-mkdir -p "$work"
-problems=()
-problem() { problems+=("$*"); }
+source "$(dirname "$0")/submission_checks.sh"
 name=01_particles_and_euler.cpp
 solution=$source_dir/solutions/$name
-
-cat >"$work/score.cmake" <<'EOF'
-file(READ ${FILE} json)
-string(JSON score ERROR_VARIABLE bad GET "${json}" score)
-if(bad)
-  message(FATAL_ERROR "not valid JSON: ${bad}")
-endif()
-message("${score}")
-EOF
-score_of() { cmake -DFILE="$1" -P "$work/score.cmake" 2>&1; }
 
 # grade NAME [ARGS...]: grades $work/NAME on ex01 with $grader (the one under test, or the copy's);
 # output in $work/NAME.out, score in $score, exit status in $code.

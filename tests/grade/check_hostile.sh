@@ -5,28 +5,12 @@
 # than its honest part earns, leave a valid report, change nothing outside its scratch folder and
 # leave no process behind; the honest chatty one must score full marks.
 set -euo pipefail
-clothlab=$1
-source_dir=$2
-work=$3
-rm -rf "$work"
-mkdir -p "$work"
-problems=()
-problem() { problems+=("$*"); }
+source "$(dirname "$0")/submission_checks.sh"
 solution=$source_dir/solutions/01_particles_and_euler.cpp
 name=01_particles_and_euler.cpp
 tree_sum() { find "$source_dir/exercises" "$source_dir/solutions" "$source_dir/tests/grade" -type f -print0 | sort -z | xargs -0 sha256sum | sha256sum; }
 sums_before=$(tree_sum)
 
-# The score in a results.json, read by CMake's JSON parser (which also proves the file valid).
-cat >"$work/score.cmake" <<'EOF'
-file(READ ${FILE} json)
-string(JSON score ERROR_VARIABLE bad GET "${json}" score)
-if(bad)
-  message(FATAL_ERROR "not valid JSON: ${bad}")
-endif()
-message("${score}")
-EOF
-score_of() { cmake -DFILE="$1" -P "$work/score.cmake" 2>&1; }
 # The top-level output of a results.json, which Gradescope shows every student.
 cat >"$work/output.cmake" <<'EOF'
 file(READ ${FILE} json)

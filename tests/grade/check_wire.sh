@@ -11,13 +11,7 @@
 # keeps its points. A kernel returning an index out of range fails its cases with the kernel and
 # the value named.
 set -euo pipefail
-clothlab=$1
-source_dir=$2
-work=$3
-rm -rf "$work"
-mkdir -p "$work"
-problems=()
-problem() { problems+=("$*"); }
+source "$(dirname "$0")/submission_checks.sh"
 
 # points FILE PREFIX: the points earned, and the points there are, by the cases whose name starts
 # with PREFIX, in a results.json (which must be valid JSON).
