@@ -387,8 +387,9 @@ void watch(Options o) {
     }
     changed.clear();
     for (const auto& file : now) {
-      if (std::find(before.begin(), before.end(), file) == before.end())
-        changed += (changed.empty() ? "" : ", ") + one_line(file.first);
+      if (std::find(before.begin(), before.end(), file) != before.end()) continue;
+      if (!changed.empty()) changed += ", ";
+      changed += one_line(file.first);
     }
     // An editor may write a file in more than one go.
     std::this_thread::sleep_for(std::chrono::milliseconds(150));
