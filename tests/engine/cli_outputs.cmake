@@ -84,8 +84,11 @@ endif()
 check_whole_frames(${WORK}/full ${frames})
 
 # A TERM in the middle of a long run: it stops after the step, writes that step as a last
-# frame, and the page.
-execute_process(COMMAND timeout --preserve-status -s TERM 2 ${CLOTHLAB} run ${WORK}/long.toml
+# frame, and the page. (--foreground: timeout signals the run alone. Without it, it signals the
+# run and then its own process group, the run again: a second TERM that comes after the first was
+# handled ends the run at once, as a second Ctrl-C does, with 143.)
+execute_process(COMMAND timeout --foreground --preserve-status -s TERM 2 ${CLOTHLAB} run
+                        ${WORK}/long.toml
                         --out ${WORK}/term
                 RESULT_VARIABLE code ERROR_VARIABLE err OUTPUT_VARIABLE out)
 if(NOT code EQUAL 130)
@@ -113,7 +116,7 @@ mass = 1
 dt = 0.001
 duration = 1
 ")
-execute_process(COMMAND timeout --preserve-status -s TERM 1 ${CLOTHLAB} run
+execute_process(COMMAND timeout --foreground --preserve-status -s TERM 1 ${CLOTHLAB} run
                         ${WORK}/gravitation.toml --out ${WORK}/gravitation
                 RESULT_VARIABLE code ERROR_VARIABLE err OUTPUT_VARIABLE out)
 if(NOT code EQUAL 130 OR NOT err MATCHES "\nstopping after this step[^\n]*\nstopped by SIGTERM (before the first step|before the first frame|during step 1)")
