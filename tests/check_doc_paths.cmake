@@ -11,9 +11,10 @@ foreach(doc ${docs})
   foreach(quoted ${paths})
     string(REPLACE "`" "" path "${quoted}")
     math(EXPR seen "${seen} + 1")
-    # A student release leaves out the solutions and the hidden grading tests on purpose.
+    # A student release leaves out the solutions, the hidden grading tests and the mistakes
+    # planted in copies of the solutions on purpose.
     set(left_out FALSE)
-    foreach(withheld solutions tests/grade-hidden)
+    foreach(withheld solutions tests/grade-hidden tests/grade/planted)
       if(path MATCHES "^${withheld}(/|$)" AND NOT EXISTS ${ROOT}/${withheld})
         set(left_out TRUE)
       endif()
