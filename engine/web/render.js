@@ -7,8 +7,9 @@
 // where colliders() is { ground: height or null, planes: [{point, normal}],
 // spheres: [{centre, radius}] } as the engine has them. A source may also give bounds() (the box
 // the camera frames, else the first positions') and trails() (the positions so far, frame by
-// frame, for drawing each particle's path; the recorded-run viewer, engine/io/viewer.html). With two sources the canvas is split
-// in two panes under one camera: the left pane shows the first source, the right the second.
+// frame, for drawing each particle's path; the recorded-run viewer, engine/io/viewer.html). With two
+// sources the canvas is split in two panes under one camera, framed for a pane's width: the
+// left pane shows the first source, the right the second.
 'use strict';
 
 const ClothlabRender = (function () {
@@ -99,6 +100,9 @@ const ClothlabRender = (function () {
       plane: new THREE.MeshPhongMaterial({ color: 0x9aa3ab, side: THREE.DoubleSide, transparent: true, opacity: 0.55 }),
     };
     const settings = { strain: false, strainScale: 0.1, springs: false };
+    // How far the camera stands back, as a multiple of the distance that frames the box in a
+    // pane at least as wide as it is tall (see fit).
+    let fitted = 1;
     let bodies = [];   // one per source: its meshes and how many triangles and springs it has
     let fixtures = []; // the ground, planes and spheres
     let sources = [];
@@ -210,8 +214,21 @@ const ClothlabRender = (function () {
         camera.near = size * 1e-3;
         camera.far = size * 1e3;
         camera.updateProjectionMatrix();
+        fitted = 1;
       }
       update();
+    }
+
+    // The camera's field of view is vertical: a pane narrower than it is tall (each half of
+    // the side-by-side split) sees less across than the box the camera was placed for, and the
+    // cloth's pinned edges fall outside it. Backed off by 1 / aspect there, the camera sees as
+    // much across as in a square pane; the user's own zoom and orbit are kept, scaled alike.
+    function fit(aspect) {
+      const wanted = Math.max(1, 1 / Math.max(aspect, 1e-3));
+      if (wanted === fitted) return;
+      const offset = camera.position.clone().sub(controls.target);
+      camera.position.copy(controls.target).add(offset.multiplyScalar(wanted / fitted));
+      fitted = wanted;
     }
 
     function update() {
@@ -250,6 +267,7 @@ const ClothlabRender = (function () {
       const panes = Math.max(bodies.length, 1);
       camera.aspect = w / panes / Math.max(h, 1);
       camera.updateProjectionMatrix();
+      fit(camera.aspect);
       controls.update();
       renderer.setScissorTest(panes > 1);
       for (let k = 0; k < panes; ++k) {

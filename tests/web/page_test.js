@@ -174,6 +174,24 @@
     page.load(first.text, first.name);
     await page.twin.start(createClothlab);
     page.setRunning(false);
+    // Each half-width pane frames its cloth: the pins (or, with none, every particle) of each
+    // are drawn inside their own pane, not cut off at its sides.
+    page.view.draw();
+    const whole = document.getElementById('canvas').getBoundingClientRect();
+    const pins = [];
+    for (let i = 0; i < api.particles(); ++i) if (api.isPinned(i)) pins.push(i);
+    const shown = pins.length ? pins : Array.from({ length: api.particles() }, (_, i) => i);
+    const outside = [];
+    for (const pane of [0, 1]) {
+      const left = whole.left + pane * whole.width / 2, right = left + whole.width / 2;
+      for (const i of shown) {
+        const [sx, sy] = page.view.screenOf(i, pane);
+        if (!(sx >= left && sx <= right && sy >= whole.top && sy <= whole.bottom)) outside.push([pane, i, Math.round(sx), Math.round(sy)]);
+      }
+    }
+    say(`side by side, each pane frames its cloth (${pins.length ? 'pins' : 'particles'} inside their pane)`,
+        shown.length > 0 && outside.length === 0,
+        `${page.view.kind} canvas ${Math.round(whole.width)} x ${Math.round(whole.height)}; outside [pane, particle, x, y]: ${JSON.stringify(outside.slice(0, 6))}`);
     for (let k = 0; k < 6; ++k) page.advance(1 / 60);
     say('side by side, the same code runs alike', !page.twin.first && page.twin.worst === 0 && page.twin.frames === 6,
         `${JSON.stringify(page.twin.first)} worst ${page.twin.worst} after ${page.twin.frames} frames`);
