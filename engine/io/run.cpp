@@ -11,6 +11,7 @@
 
 #include <fmt/format.h>
 
+#include "clothlab/core/guard.hpp"
 #include "clothlab/core/stop.hpp"
 #include "io/mesh_export.hpp"
 #include "io/output.hpp"
@@ -188,6 +189,11 @@ RunReport run_scene(Scene& scene, const RunOutputs& outputs, const ProgressFn& p
         write_page();
       }
     }
+  } catch (const SimulationError& error) {
+    // The page says why it ends where it does.
+    viewer.stopped(error.what(), error.step(), error.particle());
+    finish_after_error();
+    throw;
   } catch (...) {
     finish_after_error();
     throw;

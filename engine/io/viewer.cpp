@@ -171,6 +171,10 @@ void ViewerRecorder::thin_out() {
   stride_ *= 2;
 }
 
+void ViewerRecorder::stopped(std::string message, long step, Index particle) {
+  stop_ = Stop{std::move(message), step, particle};
+}
+
 long ViewerRecorder::frames_kept() const {
   return static_cast<long>(kept_.size()) + (last_pending_ ? 1 : 0);
 }
@@ -241,6 +245,10 @@ void ViewerRecorder::write(const World& world, const Folder& folder,
   data["kinetic"] = kinetic;
   data["potential"] = potential;
   data["total"] = total;
+  if (stop_) {
+    data["stopped"] = {{"message", stop_->message}, {"step", stop_->step}};
+    data["stopped"]["particle"] = stop_->particle >= 0 ? Json(stop_->particle) : Json(nullptr);
+  }
   // Colliders, drawn so that a student sees what the cloth lies on.
   data["colliders"] = Json::array();
   for (const auto& effect : world.post_step_effects) {

@@ -12,6 +12,7 @@
 #pragma once
 
 #include <filesystem>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -47,6 +48,11 @@ class ViewerRecorder {
   // The same for the page `name` in `folder` (a run's folder, held open: io/files.hpp).
   void write(const World& world, const Folder& folder, const std::string& name) const;
 
+  // Says on the page that the guard stopped the run (a SimulationError): its message, the step
+  // and the particle it names (-1: none), shown over the cloth, and the page's last frame marked
+  // as the last before the stop. Call it before the last write.
+  void stopped(std::string message, long step, Index particle);
+
   long frames_offered() const { return offered_; }
   long frames_kept() const;  // the frames the page holds, the last one included
 
@@ -79,6 +85,12 @@ class ViewerRecorder {
   std::vector<std::pair<long, std::vector<Triangle>>> surfaces_;
   std::vector<Triangle> last_surface_;  // last_'s surface, when it differs from the kept ones
   bool last_surface_differs_ = false;
+  struct Stop {
+    std::string message;
+    long step = 0;
+    Index particle = -1;
+  };
+  std::optional<Stop> stop_;  // the guard's, when it stopped the run
 };
 
 }  // namespace clothlab

@@ -7,11 +7,19 @@
 Both on the 2D canvas (a browser without WebGL) and, with --webgl (the build put three.js in the
 page), with WebGL through the live pages' renderer, which the page must then say it uses.
 
-Exit 0 when both hold, 1 when one fails, 77 (ctest's "skipped") when no Chromium is installed,
+With --blowup SCENE (a scene the guard stops), also:
+
+  3. The page of a run the guard stopped says so: the guard's message, its step and particle,
+     and its last frame marked as the last before the stop (read from the page's DOM as the
+     browser left it).
+
+Exit 0 when all hold, 1 when one fails, 77 (ctest's "skipped") when no Chromium is installed,
 unless CLOTHLAB_REQUIRE_BROWSER=1 (as in CI), which makes a missing browser a failure.
 """
 import argparse
+import html
 import os
+import re
 import shutil
 import struct
 import subprocess
@@ -114,13 +122,50 @@ def check_pictures(first, later, background, what):
     return ok
 
 
+def check_stopped_page(browser, clothlab, scene, work, profile):
+    """Runs `scene`, which the guard must stop, and reads its page's DOM at the last frame."""
+    run = os.path.join(work, "blowup")
+    page = os.path.join(run, "view.html")
+    result = subprocess.run([clothlab, "run", scene, "--out", run, "--html", page, "--force"],
+                            capture_output=True, text=True)
+    found = re.search(r"(blew up|ran away) at step (\d+) .*?particle (\d+)", result.stderr)
+    if result.returncode == 0 or not found:
+        print(f"FAIL: {scene} was to be stopped by the guard; exit {result.returncode}, "
+              f"stderr: {result.stderr.strip()}")
+        return False
+    kind, step, particle = found.groups()
+    dom = subprocess.run(
+        browser_command(browser, profile, NO_WEBGL) +
+        ["--dump-dom", f"file://{os.path.abspath(page)}?frame={10**6}"],
+        check=True, capture_output=True, text=True, timeout=120).stdout
+    box = re.search(r'<div id="stopped"[^>]*>(.*?)</div>', dom, re.S)
+    clock = re.search(r'<span id="clock">(.*?)</span>', dom, re.S)
+    text = html.unescape(box.group(1)) if box else ""
+    shown = box is not None and "display: block" in box.group(0)
+    checks = [
+        ("the page shows the guard's message", shown and f"{kind} at step {step}" in text),
+        (f"it names the step ({step}) and the particle ({particle})",
+         f"at step {step}, at particle {particle};" in text),
+        ("its last frame is marked as the last before the stop",
+         clock is not None and "the guard stopped the run" in clock.group(1)),
+    ]
+    ok = True
+    for what, good in checks:
+        print(f"{'ok' if good else 'FAIL'}: stopped run: {what}")
+        ok = ok and good
+    if not ok:
+        print(f"  the page's box: {text!r}; its clock: {clock.group(1) if clock else None!r}")
+    return ok
+
+
 def main():
     parser = argparse.ArgumentParser()
     parser.add_argument("--clothlab", required=True)
-    parser.add_argument("--scene", required=True)
+    parser.add_argument("--scene", help="a scene to run and check the pictures of")
     parser.add_argument("--work", required=True)
     parser.add_argument("--webgl", action="store_true",
                         help="the page carries three.js: check its WebGL drawing too")
+    parser.add_argument("--blowup", help="a scene the guard stops: check that its page says so")
     args = parser.parse_args()
 
     browser = shutil.which("chromium") or shutil.which("chromium-browser")
@@ -131,13 +176,14 @@ def main():
     os.makedirs(args.work, exist_ok=True)
     run = os.path.join(args.work, "run")  # the run's own folder; the screenshots beside it
     page = os.path.join(run, "view.html")
-    subprocess.run([args.clothlab, "run", args.scene, "--out", run, "--html", page],
-                   check=True, stdout=subprocess.DEVNULL)
+    if args.scene:
+        subprocess.run([args.clothlab, "run", args.scene, "--out", run, "--html", page],
+                       check=True, stdout=subprocess.DEVNULL)
     profile = tempfile.mkdtemp(prefix="clothlab-chromium-")
     ok = True
     try:
-        passes = [("2D canvas", NO_WEBGL, BACKGROUND, "2d")]
-        if args.webgl:
+        passes = [("2D canvas", NO_WEBGL, BACKGROUND, "2d")] if args.scene else []
+        if args.webgl and args.scene:
             passes.append(("WebGL", WEBGL, WEBGL_BACKGROUND, "webgl"))
         for what, flags, background, expected in passes:
             renderer = renderer_of(browser, page, profile, flags)
@@ -149,6 +195,8 @@ def main():
             first = screenshot(browser, page, 0, stem + "-first.png", profile, flags)
             later = screenshot(browser, page, 10**6, stem + "-last.png", profile, flags)
             ok = check_pictures(first, later, background, what) and ok
+        if args.blowup:
+            ok = check_stopped_page(browser, args.clothlab, args.blowup, args.work, profile) and ok
     finally:
         shutil.rmtree(profile, ignore_errors=True)
     return 0 if ok else 1
