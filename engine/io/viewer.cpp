@@ -225,12 +225,11 @@ void ViewerRecorder::write(const World& world, const Folder& folder,
   for (const Frame& frame : kept_)
     frames.push_back(&frame);
   if (last_pending_) frames.push_back(&last_);
-  std::vector<double> times, kinetic, potential, total;
+  std::vector<double> times, kinetic, potential;
   for (const Frame* frame : frames) {
     times.push_back(frame->t);
     kinetic.push_back(frame->kinetic);
     potential.push_back(frame->potential);
-    total.push_back(frame->kinetic + frame->potential);
   }
 
   // The small part of the data through the JSON library; the mesh and the frames, which may be
@@ -244,7 +243,6 @@ void ViewerRecorder::write(const World& world, const Folder& folder,
   data["times"] = times;
   data["kinetic"] = kinetic;
   data["potential"] = potential;
-  data["total"] = total;
   if (stop_) {
     data["stopped"] = {{"message", stop_->message}, {"step", stop_->step}};
     data["stopped"]["particle"] = stop_->particle >= 0 ? Json(stop_->particle) : Json(nullptr);

@@ -154,11 +154,7 @@
     $('play').textContent = running ? 'Pause' : 'Play';
   }
 
-  function formatValue(v) {
-    if (v === 0) return '0';
-    const a = Math.abs(v);
-    return a >= 1e4 || a < 1e-3 ? v.toExponential(3) : String(Number(v.toPrecision(4)));
-  }
+  const formatValue = ClothlabRender.formatValue;
 
   // A slider over [value / 10, value * 10] on a log scale for a positive number; linear over
   // a symmetric range for one that may be negative or is 0. Either is cut to the values the
@@ -309,32 +305,7 @@
       this.t.push(t); this.k.push(k); this.u.push(u);
       if (this.t.length > 600) { this.t.shift(); this.k.shift(); this.u.shift(); }
     },
-    draw() {
-      const c = $('energy');
-      const g = c.getContext('2d');
-      g.clearRect(0, 0, c.width, c.height);
-      const n = this.t.length;
-      if (n < 2) return;
-      const total = this.k.map((k, i) => k + this.u[i]);
-      const all = this.k.concat(this.u, total);
-      let lo = Math.min(...all), hi = Math.max(...all);
-      if (hi - lo < 1e-12) { hi += 1; lo -= 1; }
-      const x = (i) => 4 + (c.width - 8) * (this.t[i] - this.t[0]) / Math.max(this.t[n - 1] - this.t[0], 1e-12);
-      const y = (v) => c.height - 4 - (c.height - 8) * (v - lo) / (hi - lo);
-      const line = (values, colour) => {
-        g.strokeStyle = colour;
-        g.beginPath();
-        values.forEach((v, i) => (i ? g.lineTo(x(i), y(v)) : g.moveTo(x(i), y(v))));
-        g.stroke();
-      };
-      line(this.k, '#c0392b');
-      line(this.u, '#2c6e9e');
-      line(total, '#222');
-      g.fillStyle = '#555';
-      g.font = '10px monospace';
-      g.fillText(`${formatValue(hi)} J`, 6, 12);
-      g.fillText(`${formatValue(lo)} J`, 6, c.height - 6);
-    },
+    draw() { ClothlabRender.plotEnergy($('energy'), this.t, this.k, this.u); },
   };
 
   // --- Drawing ----------------------------------------------------------------------------

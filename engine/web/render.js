@@ -1,5 +1,6 @@
-// render.js: draws one cloth, or two side by side, with three.js (WebGL), or flat on a 2D
-// canvas where WebGL is missing. The live pages (live.js) give it their engines as *sources*:
+// render.js: draws one cloth, or two side by side, with three.js (WebGL), or with a painter of
+// its own on a 2D canvas where WebGL is missing, and plots the energies. The live pages (live.js) give it their
+// engines as *sources*, and the recorded-run viewer (engine/io/viewer.html) its frames:
 //
 //   { count(), positions() (3 numbers a particle), triangles(), springs() (index arrays),
 //     isPinned(i), strains() (one number a particle: l / l0 - 1), colliders() }
@@ -330,56 +331,200 @@ const ClothlabRender = (function () {
     });
   }
 
-  // Without WebGL: the particles and springs drawn flat on a 2D canvas, seen from the front,
-  // strained springs in colour when asked for.
+  // Without WebGL: each source painted on the 2D canvas, seen from an orbiting camera with a
+  // gentle perspective: the triangles flat-shaded by how squarely they face a light over the
+  // viewer's shoulder (both sides lit alike: cloth has no inside; coloured by strain when asked
+  // for), farthest first (the painter's algorithm), with the ground's grid, the planes, the
+  // spheres, the springs, the pins and, where the source gives them, the particles' trails. A
+  // few thousand triangles a frame; it needs no library.
   function makeCanvasView(canvas, labels) {
     const g = canvas.getContext('2d');
+    const settings = { strain: false, strainScale: 0.1, springs: false };
+    const camera = { yaw: 0.6, pitch: 0.35, zoom: 1 };
     let box = null;
     let sources = [];
-    const settings = { strain: false, strainScale: 0.1, springs: false };
-    const scale = (panes) => 0.8 * Math.min(canvas.width / panes, canvas.height) / Math.max(box.size, 1e-9);
-    const screen = (x, i, pane, panes) => {
-      const w = canvas.width / panes, s = scale(panes);
-      return [pane * w + w / 2 + s * (x[3 * i] - box.centre[0]), canvas.height / 2 - s * (x[3 * i + 1] - box.centre[1])];
-    };
     const panes = () => Math.max(sources.length, 1);
+    const radius = () => Math.max(1e-6, Math.hypot(box.hi[0] - box.lo[0], box.hi[1] - box.lo[1], box.hi[2] - box.lo[2]) / 2);
+
+    // The pane `index` of the canvas, in canvas pixels: its left edge, size and scale [px/m].
+    function paneView(index) {
+      const w = canvas.width / panes(), h = canvas.height;
+      return { left: index * w, w, h, scale: camera.zoom * 0.42 * Math.min(w, h) / radius() };
+    }
+    // World point -> [x, y, depth] in the pane's canvas pixels. y is up in the world and down
+    // on the screen.
+    function project(p, view) {
+      const c = box.centre, r = radius();
+      const x = p[0] - c[0], y = p[1] - c[1], z = p[2] - c[2];
+      const cx = Math.cos(camera.yaw) * x - Math.sin(camera.yaw) * z;
+      const cz = Math.sin(camera.yaw) * x + Math.cos(camera.yaw) * z;
+      const cy = Math.cos(camera.pitch) * y - Math.sin(camera.pitch) * cz;
+      const depth = Math.sin(camera.pitch) * y + Math.cos(camera.pitch) * cz;
+      const scale = view.scale / (1 + depth / (4 * r));
+      return [view.left + view.w / 2 + cx * scale, view.h / 2 - cy * scale, depth];
+    }
+    // The world point that projects to canvas pixel (sx, sy) at `depth`: project's inverse.
+    function unproject(sx, sy, depth, view) {
+      const scale = view.scale / (1 + depth / (4 * radius()));
+      const cx = (sx - view.left - view.w / 2) / scale, cy = (view.h / 2 - sy) / scale;
+      const sp = Math.sin(camera.pitch), cp = Math.cos(camera.pitch);
+      const sw = Math.sin(camera.yaw), cw = Math.cos(camera.yaw);
+      const y = cp * cy + sp * depth, cz = -sp * cy + cp * depth;
+      const x = cw * cx + sw * cz, z = -sw * cx + cw * cz;
+      return [box.centre[0] + x, box.centre[1] + y, box.centre[2] + z];
+    }
+
+    // A grid of lines in the plane through `origin` spanned by unit vectors u and v.
+    function grid(origin, u, v, view) {
+      const span = 1.2 * radius(), step = span / 10;
+      const at = (a, b) => project([0, 1, 2].map((k) => origin[k] + a * u[k] + b * v[k]), view);
+      g.strokeStyle = 'rgba(120, 110, 90, 0.35)';
+      g.lineWidth = devicePixelRatio;
+      g.beginPath();
+      for (let k = -10; k <= 10; ++k) {
+        const a = at(k * step, -span), b = at(k * step, span), d = at(-span, k * step), e = at(span, k * step);
+        g.moveTo(a[0], a[1]); g.lineTo(b[0], b[1]);
+        g.moveTo(d[0], d[1]); g.lineTo(e[0], e[1]);
+      }
+      g.stroke();
+    }
+
+    function paint(source, view) {
+      const x = source.positions(), n = x.length / 3;
+      const tris = source.triangles(), springs = source.springs();
+      const p = (i) => [x[3 * i], x[3 * i + 1], x[3 * i + 2]];
+      const screen = new Array(n);
+      for (let i = 0; i < n; ++i) screen[i] = project(p(i), view);
+      const c = box.centre;
+      const colliders = source.colliders();
+      if (colliders.ground !== null && colliders.ground !== undefined) {
+        grid([c[0], colliders.ground, c[2]], [1, 0, 0], [0, 0, 1], view);
+      }
+      // A plane (a ramp): the grid laid in it around the point nearest the box's centre.
+      const dot = (a, b) => a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+      const cross = (a, b) => [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]];
+      const unit = (a) => { const l = Math.hypot(a[0], a[1], a[2]) || 1; return [a[0] / l, a[1] / l, a[2] / l]; };
+      for (const plane of colliders.planes) {
+        const nn = unit(plane.normal);
+        const t1 = unit(Math.abs(nn[1]) < 0.9 ? cross(nn, [0, 1, 0]) : cross(nn, [1, 0, 0]));
+        const off = dot([c[0] - plane.point[0], c[1] - plane.point[1], c[2] - plane.point[2]], nn);
+        grid([c[0] - off * nn[0], c[1] - off * nn[1], c[2] - off * nn[2]], t1, cross(nn, t1), view);
+      }
+
+      // Triangles and spheres, farthest first.
+      const order = [];
+      for (let t = 0; t < tris.length; t += 3) {
+        order.push([t, screen[tris[t]][2] + screen[tris[t + 1]][2] + screen[tris[t + 2]][2]]);
+      }
+      for (const sphere of colliders.spheres) {
+        const q = project(sphere.centre, view);
+        order.push([{ sphere, at: q }, 3 * q[2]]);  // its centre, on the triangles' scale
+      }
+      order.sort((a, b) => b[1] - a[1]);
+      const light = [0.3, 0.8, 0.5];
+      const strain = settings.strain ? source.strains() : null;
+      const rgb = [0, 0, 0];
+      for (const [t] of order) {
+        if (typeof t === 'object') {  // a sphere: a shaded disc
+          const s = t.sphere;
+          const edge = project([s.centre[0] + s.radius, s.centre[1], s.centre[2]], view);
+          const r = Math.hypot(edge[0] - t.at[0], edge[1] - t.at[1]) || 1;
+          const shade = g.createRadialGradient(t.at[0] - r / 3, t.at[1] - r / 3, r / 10, t.at[0], t.at[1], r);
+          shade.addColorStop(0, '#e8dcc8');
+          shade.addColorStop(1, '#9c8a6c');
+          g.fillStyle = shade;
+          g.beginPath();
+          g.arc(t.at[0], t.at[1], r, 0, 2 * Math.PI);
+          g.fill();
+          continue;
+        }
+        const a = p(tris[t]), b = p(tris[t + 1]), d = p(tris[t + 2]);
+        const u = [b[0] - a[0], b[1] - a[1], b[2] - a[2]], v = [d[0] - a[0], d[1] - a[1], d[2] - a[2]];
+        const nrm = cross(u, v);
+        const lit = Math.abs(dot(nrm, light)) / (Math.hypot(...nrm) || 1);
+        if (strain) {
+          strainColour((strain[tris[t]] + strain[tris[t + 1]] + strain[tris[t + 2]]) / 3, settings.strainScale, rgb, 0);
+          const k = 0.55 + 0.45 * lit;
+          g.fillStyle = `rgb(${rgb.map((q) => Math.round(255 * k * q)).join(',')})`;
+        } else {
+          const shade = Math.round(90 + 150 * lit);
+          g.fillStyle = `rgb(${Math.round(shade * 0.55)}, ${Math.round(shade * 0.7)}, ${shade})`;
+        }
+        g.strokeStyle = g.fillStyle;
+        g.beginPath();
+        for (const i of [tris[t], tris[t + 1], tris[t + 2]]) g.lineTo(screen[i][0], screen[i][1]);
+        g.closePath();
+        g.fill();
+        g.stroke();  // closes the hairline gaps between neighbouring triangles
+      }
+      if (settings.springs || tris.length === 0) {
+        g.lineWidth = devicePixelRatio;
+        for (let s = 0; s < springs.length; s += 2) {
+          if (strain) strainColour(Math.max(strain[springs[s]], strain[springs[s + 1]]), settings.strainScale, rgb, 0);
+          g.strokeStyle = strain ? `rgb(${rgb.map((q) => Math.round(255 * q)).join(',')})` : 'rgba(40, 40, 40, 0.5)';
+          g.beginPath();
+          g.moveTo(screen[springs[s]][0], screen[springs[s]][1]);
+          g.lineTo(screen[springs[s + 1]][0], screen[springs[s + 1]][1]);
+          g.stroke();
+        }
+      }
+      // The path each particle has taken so far (a scene of a few free particles).
+      if (source.trails) {
+        g.strokeStyle = 'rgba(31, 78, 121, 0.45)';
+        g.lineWidth = 1.5 * devicePixelRatio;
+        const history = source.trails();
+        for (let i = 0; i < n; ++i) {
+          g.beginPath();
+          for (const frame of history) {
+            const q = project([frame[3 * i], frame[3 * i + 1], frame[3 * i + 2]], view);
+            g.lineTo(q[0], q[1]);
+          }
+          g.stroke();
+        }
+      }
+      // Pins, and the particles of a scene without triangles, as dots.
+      const size = 3 * devicePixelRatio;
+      for (let i = 0; i < n; ++i) {
+        const pinned = source.isPinned(i);
+        if (tris.length && !pinned) continue;
+        g.fillStyle = pinned ? '#c0392b' : '#1f4e79';
+        g.beginPath();
+        g.arc(screen[i][0], screen[i][1], pinned ? 1.6 * size : size, 0, 2 * Math.PI);
+        g.fill();
+      }
+    }
+
+    // Client point -> canvas pixels, and back.
+    const ratio = () => canvas.width / Math.max(canvas.getBoundingClientRect().width, 1);
+
     return {
       kind: '2d',
       settings,
+      camera,
       rebuild(list) { sources = list; box = list[0].bounds ? list[0].bounds() : framed(list[0]); },
       update() {},
       draw() {
-        canvas.width = canvas.clientWidth;
-        canvas.height = canvas.clientHeight;
-        g.clearRect(0, 0, canvas.width, canvas.height);
-        sources.forEach((source, pane) => {
-          const x = source.positions();
-          const tris = source.triangles();
-          g.strokeStyle = '#c8553d';
+        canvas.width = canvas.clientWidth * devicePixelRatio;
+        canvas.height = canvas.clientHeight * devicePixelRatio;
+        g.fillStyle = '#f4f4f1';
+        g.fillRect(0, 0, canvas.width, canvas.height);
+        sources.forEach((source, index) => {
+          const view = paneView(index);
+          g.save();
           g.beginPath();
-          for (let k = 0; k < tris.length; k += 3) {
-            const a = screen(x, tris[k], pane, panes()), b = screen(x, tris[k + 1], pane, panes());
-            const c = screen(x, tris[k + 2], pane, panes());
-            g.moveTo(...a); g.lineTo(...b); g.lineTo(...c); g.closePath();
-          }
-          g.stroke();
-          if (settings.strain || settings.springs || !tris.length) {
-            const springs = source.springs(), strain = settings.strain ? source.strains() : null;
-            const rgb = [0, 0, 0];
-            for (let k = 0; k < springs.length; k += 2) {
-              if (strain) strainColour(Math.max(strain[springs[k]], strain[springs[k + 1]]), settings.strainScale, rgb, 0);
-              g.strokeStyle = strain ? `rgb(${rgb.map((c) => Math.round(255 * c)).join(',')})` : '#333';
-              g.beginPath();
-              g.moveTo(...screen(x, springs[k], pane, panes()));
-              g.lineTo(...screen(x, springs[k + 1], pane, panes()));
-              g.stroke();
-            }
-          }
-          g.fillStyle = '#222';
-          for (let i = 0; i < x.length / 3; ++i) g.fillRect(...screen(x, i, pane, panes()).map((v) => v - 1.5), 3, 3);
+          g.rect(view.left, 0, view.w, view.h);
+          g.clip();
+          paint(source, view);
+          g.restore();
         });
         showLabels(labels, panes());
       },
+      // Turns the camera (the mouse's drag) and moves it nearer or farther (the wheel).
+      orbit(dx, dy) {
+        camera.yaw += dx;
+        camera.pitch = Math.max(-1.5, Math.min(1.5, camera.pitch + dy));
+      },
+      zoomBy(factor) { camera.zoom *= factor; },
       pick(clientX, clientY) {
         const pane = paneAt(canvas, panes(), clientX).index;
         const x = sources[pane].positions();
@@ -392,19 +537,70 @@ const ClothlabRender = (function () {
         return best;
       },
       screenOf(i, pane = 0) {
-        const rect = canvas.getBoundingClientRect();
-        const [sx, sy] = screen(sources[pane].positions(), i, pane, panes());
-        return [rect.left + sx, rect.top + sy];
+        const rect = canvas.getBoundingClientRect(), k = ratio();
+        const x = sources[pane].positions();
+        const [sx, sy] = project([x[3 * i], x[3 * i + 1], x[3 * i + 2]], paneView(pane));
+        return [rect.left + sx / k, rect.top + sy / k];
       },
+      // Where the mouse points on the plane through `point` facing the camera.
       pointOnPlane(clientX, clientY, point) {
-        const { rect } = paneAt(canvas, panes(), clientX);
-        const s = scale(panes());
-        return [box.centre[0] + (clientX - rect.left - rect.width / 2) / s,
-                box.centre[1] - (clientY - rect.top - rect.height / 2) / s, point[2]];
+        const rect = canvas.getBoundingClientRect(), k = ratio();
+        const view = paneView(paneAt(canvas, panes(), clientX).index);
+        const depth = project(point, view)[2];
+        return unproject((clientX - rect.left) * k, (clientY - rect.top) * k, depth, view);
       },
       controls: null,
     };
   }
 
-  return { makeView, bounds, strainColour };
+  // A number as the pages print it: four significant digits, or an exponent when very large or
+  // small.
+  function formatValue(v) {
+    if (v === 0) return '0';
+    const a = Math.abs(v);
+    return a >= 1e4 || a < 1e-3 ? v.toExponential(3) : String(Number(v.toPrecision(4)));
+  }
+
+  // The energy plot, on a 2D canvas of its own: kinetic (red), potential (blue) and their sum
+  // (black) against time t [s], with the range's ends in joules. options.at marks one time (the
+  // recorded-run viewer's frame); options.stopped marks the right end in red (a run the guard
+  // stopped there).
+  function plotEnergy(canvas, t, kinetic, potential, options = {}) {
+    const g = canvas.getContext('2d');
+    g.clearRect(0, 0, canvas.width, canvas.height);
+    const n = t.length;
+    if (n < 2) return;
+    const total = kinetic.map((k, i) => k + potential[i]);
+    let lo = Infinity, hi = -Infinity;
+    for (const series of [kinetic, potential, total]) {
+      for (const v of series) if (Number.isFinite(v)) { lo = Math.min(lo, v); hi = Math.max(hi, v); }
+    }
+    if (!(hi - lo >= 1e-12)) { hi = (Number.isFinite(hi) ? hi : 0) + 1; lo = hi - 2; }
+    const span = Math.max(t[n - 1] - t[0], 1e-12);
+    const x = (time) => 4 + (canvas.width - 8) * (time - t[0]) / span;
+    const y = (v) => canvas.height - 4 - (canvas.height - 8) * (v - lo) / (hi - lo);
+    const line = (values, colour) => {
+      g.strokeStyle = colour;
+      g.beginPath();
+      values.forEach((v, i) => (i ? g.lineTo(x(t[i]), y(v)) : g.moveTo(x(t[i]), y(v))));
+      g.stroke();
+    };
+    line(kinetic, '#c0392b');
+    line(potential, '#2c6e9e');
+    line(total, '#222');
+    g.fillStyle = '#555';
+    g.font = '10px monospace';
+    g.fillText(`${formatValue(hi)} J`, 6, 12);
+    g.fillText(`${formatValue(lo)} J`, 6, canvas.height - 6);
+    if (options.stopped) {
+      g.fillStyle = '#c0392b';
+      g.fillRect(canvas.width - 3, 0, 3, canvas.height);
+    }
+    if (options.at !== undefined) {
+      g.fillStyle = 'rgba(0, 0, 0, 0.25)';
+      g.fillRect(x(options.at) - 1, 0, 2, canvas.height);
+    }
+  }
+
+  return { makeView, bounds, strainColour, formatValue, plotEnergy };
 })();

@@ -4,8 +4,9 @@
   1. The cloth is drawn: the picture of the first frame is not a blank canvas.
   2. It moves: a later frame's picture differs from the first.
 
-Both on the 2D canvas (a browser without WebGL) and, with --webgl (the build put three.js in the
-page), with WebGL through the live pages' renderer, which the page must then say it uses.
+Both drawn by the live pages' renderer (engine/web/render.js), which the page must say it uses:
+with its painter on a 2D canvas (a browser without WebGL) and, with --webgl (the build put
+three.js in the page), with WebGL.
 
 With --blowup SCENE (a scene the guard stops), also:
 
@@ -94,11 +95,12 @@ def screenshot(browser, page, frame, out, profile, flags):
 
 
 def renderer_of(browser, page, profile, flags):
-    """What the page says it draws with: "webgl", or "2d" when it says nothing."""
+    """What the page says it draws with: the kind of the renderer's view ("webgl" or "2d")."""
     dom = subprocess.run(
         browser_command(browser, profile, flags) + ["--dump-dom", f"file://{os.path.abspath(page)}?frame=0"],
         check=True, capture_output=True, text=True, timeout=120).stdout
-    return "webgl" if 'data-renderer="webgl"' in dom else "2d"
+    found = re.search(r'data-renderer="([a-z0-9]+)"', dom)
+    return found.group(1) if found else "nothing (no renderer)"
 
 
 def check_pictures(first, later, background, what):
