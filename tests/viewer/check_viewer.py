@@ -149,7 +149,7 @@ def check_stopped_page(browser, clothlab, scene, work, profile):
         (f"it names the step ({step}) and the particle ({particle})",
          f"at step {step}, at particle {particle};" in text),
         ("its last frame is marked as the last before the stop",
-         clock is not None and "the guard stopped the run" in clock.group(1)),
+         clock is not None and "(stopped here)" in clock.group(1)),
     ]
     ok = True
     for what, good in checks:
