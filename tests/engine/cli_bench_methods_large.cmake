@@ -1,10 +1,10 @@
 # `clothlab bench methods --large --quick`: the wiring of lesson 12's cloths of real size in
 # seconds (one frame, one rung a method but RK4, a cheap reference; the real run takes many
-# minutes).
-# Each of the three large scenes gives its rows; each cloth is 48 x 48 or more, and symplectic
-# Euler's advised step is 50 or more steps a frame of 1/60 s (the regime the large-step methods
-# are for). Then the `bakeoff-update-lesson` script: it copies nothing when a file of the bake-off
-# is missing, and all of them when they are there.
+# minutes). Each of the three large scenes gives its rows; each cloth is 48 x 48 or more, and
+# symplectic Euler's advised step is 50 or more steps a frame of 1/60 s (the regime the large-step
+# methods are for). Then the `bakeoff-update-lesson` script: it copies nothing when a file of the
+# bake-off is missing, and all of them when they are there; and the `bakeoff` target writes into
+# the build tree alone.
 cmake_policy(VERSION 3.22)
 include(${CMAKE_CURRENT_LIST_DIR}/cli_bench_checks.cmake)
 file(REMOVE_RECURSE ${WORK})
@@ -80,3 +80,12 @@ foreach(pair "bakeoff/methods.csv=bakeoff.csv" "bakeoff/speed.csv=bakeoff-speed.
     message(FATAL_ERROR "${target} holds '${text}', not ${source}")
   endif()
 endforeach()
+
+# The `bakeoff` target itself writes into the build tree only: its commands name no folder of
+# the sources (the lesson's CSVs and plots change only through bakeoff-update-lesson).
+get_filename_component(lessons ${UPDATE_SCRIPT} DIRECTORY)
+file(READ ${lessons}/CMakeLists.txt lessons_cmake)
+string(REGEX MATCH "add_custom_target\\(bakeoff\n[^)]*\\)" bakeoff "${lessons_cmake}")
+if(bakeoff STREQUAL "" OR bakeoff MATCHES "SOURCE_DIR|12-xpbd")
+  message(FATAL_ERROR "the bakeoff target is missing or writes into the sources:\n${bakeoff}")
+endif()
