@@ -9,15 +9,18 @@ cmake_policy(VERSION 3.22)
 include(${CMAKE_CURRENT_LIST_DIR}/cli_bench_checks.cmake)
 file(REMOVE_RECURSE ${WORK})
 file(MAKE_DIRECTORY ${WORK})
+# The reference by symplectic Euler (the engine room's, the cheapest step), to check --reference.
 run_bench("bench methods --large --quick" bench methods --large --quick --no-plot
-          --min-seconds 0.001 --out large)
+          --min-seconds 0.001 --reference symplectic-euler --out large)
 # Per scene: the reference, then one rung each of symplectic Euler, implicit Euler, XPBD, and
 # the local/global solver when the engine has it.
 read_methods_csv(${WORK}/large/methods.csv 4 5)
 set(frames 1)  # --quick --large
 foreach(scene bakeoff-large-sheet bakeoff-large-flag bakeoff-large-drape)
-  if(NOT out MATCHES "scene [^\n]*${scene}.toml: ${frames} frames")
-    message(FATAL_ERROR "${scene}: not run for ${frames} frames\n${out}")
+  if(NOT out MATCHES "scene [^\n]*${scene}.toml: ${frames} frames[^\n]*\n[^\n]*\n[^\n]*\n  \
+reference \\(symplectic-euler\\) ")
+    message(FATAL_ERROR "${scene}: not run for ${frames} frames against a symplectic Euler "
+                        "reference\n${out}")
   endif()
   # The cloth's size, from the scene file itself.
   file(READ ${LESSON}/${scene}.toml text)
