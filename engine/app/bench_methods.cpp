@@ -51,9 +51,13 @@ using Clock = std::chrono::steady_clock;
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 constexpr double kFrame = 1.0 / 60.0;  // [s]: errors are sampled once a frame of a 60 Hz game
+constexpr int kLargeBelow = 8;  // the large cloths' reference: 8 times below its advised limit
 
 struct MethodsOptions {
-  std::vector<std::string> scenes;  // empty: lesson 12's three bake-off scenes
+  std::vector<std::string> scenes;  // empty: lesson 12's three bake-off scenes (or large ones)
+  bool large = false;               // the cloths of real size: 48 x 48, woven stiffness
+  std::string reference;            // empty: rk4 (see reference_config)
+  int reference_below = 0;          // 0: the default factor below the advised limit
   std::string out = "clothlab-out/methods";
   std::string plot;  // empty: OUT/methods.svg
   bool no_plot = false;
@@ -83,7 +87,24 @@ struct Ladder {
   std::vector<std::pair<int, int>> inner = {{0, 0}};
 };
 
-std::vector<Ladder> ladders(bool quick) {
+std::vector<Ladder> ladders(bool quick, bool large) {
+  if (large && quick) {  // the wiring, in seconds: one rung of each method but RK4
+    return {{"symplectic-euler", true, {1}},
+            {"implicit-euler", false, {1}},
+            {"xpbd", false, {1}, {{4, 1}}},
+            {"local-global", false, {1}, {{0, 10}}}};
+  }
+  if (large) {
+    // A cloth of real size at a game's frame: the explicit methods need hundreds of steps a
+    // frame, so their ladders are short (symplectic Euler's first rung, at twice the advised
+    // step, shows the limit is real); the large-step methods get the longer ladders.
+    return {{"symplectic-euler", true, {0.5, 1, 2}},
+            {"rk4", true, {1, 2}},
+            {"implicit-euler", false, {1, 4, 16}},
+            {"xpbd", false, {1}, {{1, 1}, {4, 1}, {16, 1}, {64, 1}, {1, 16}}},
+            {"xpbd", false, {8}, {{8, 1}}},
+            {"local-global", false, {1, 4, 16}, {{0, 10}}}};
+  }
   if (quick) {
     return {{"symplectic-euler", true, {1, 2, 4}},
             {"rk4", true, {1, 2}},
@@ -238,29 +259,44 @@ std::string setting(const Config& c) {
 
 void print_row(const MethodRun& r) {
   fmt::print("  {:<17} {:>9.3g} {:>19} {:>9} {:>9} {:>9} {:>12}  {}\n",
-             r.reference ? "reference (rk4)" : r.config.method, r.config.dt(), setting(r.config),
-             sci(r.error), sci(r.worst_strain), sci(r.energy_lost), sci(r.wall_per_sim),
+             r.reference ? fmt::format("reference ({})", r.config.method) : r.config.method,
+             r.config.dt(), setting(r.config), sci(r.error), sci(r.worst_strain),
+             sci(r.energy_lost), sci(r.wall_per_sim),
              r.reference ? "its own difference at dt/2" : (r.stable ? "yes" : "no"));
+}
+
+// The reference's method and step: `--reference` (default RK4) at a step `--reference-below`
+// times below its advised limit. On the small cloths that is 128 (--quick: 16): 16 (4) times
+// below the finest rung of the ladders, that far because a scene's wind and colliders make
+// every method first order (see the lesson). On the large cloths a step costs 20 times more (8930
+// springs against 440) and the advised step is 9 times smaller, so 128 would cost 180 times the
+// small sheet's reference a simulated second: kLargeBelow is 8, still 4 times below the finest
+// rung of RK4 and symplectic Euler. --quick --large, one frame to check the
+// wiring, takes 2. Either way the bench runs the reference again at half its step and prints
+// the difference: the reference has converged where that is far below every method's error.
+Config reference_setting(const BakeoffScene& scene, const MethodsOptions& opt) {
+  int below = opt.reference_below;
+  if (below == 0) below = opt.large ? (opt.quick ? 2 : kLargeBelow) : (opt.quick ? 16 : 128);
+  const std::string method = opt.reference.empty() ? "rk4" : opt.reference;
+  return Config{method, below * advised_per_frame(scene, method)};
 }
 
 // Every run of one scene, the reference first.
 std::vector<MethodRun> bake_off(const std::string& path, const MethodsOptions& opt) {
-  // --quick: half a second at most.
-  const BakeoffScene scene = read_bakeoff_scene(path, opt.quick ? 30 : 1'000'000);
+  // --quick: half a second at most; with --large, one frame.
+  const BakeoffScene scene = read_bakeoff_scene(path, opt.quick ? (opt.large ? 1 : 30) : 1'000'000);
   const double sim_seconds = scene.frames * kFrame;
   fmt::print("\nscene {}: {} frames of 1/60 s ({:.3g} s), size {:.3g} m\n", path, scene.frames,
              sim_seconds, scene.size);
 
-  // The reference: RK4 at a step 128 (quick: 16) times below its advised limit, 16 (quick: 4)
-  // times below the finest rung of the ladders, and at half that step. That far, because a
-  // scene's wind and colliders make every method first order (see the lesson).
-  const int per_frame_ref = (opt.quick ? 16 : 128) * advised_per_frame(scene, "rk4");
-  const Config reference_config{"rk4", per_frame_ref};
+  const Config reference_config = reference_setting(scene, opt);
   const Trajectory reference = simulate(scene, reference_config, true);
-  const Trajectory finer = simulate(scene, Config{"rk4", 2 * per_frame_ref}, true);
+  const Trajectory finer =
+      simulate(scene, Config{reference_config.method, 2 * reference_config.per_frame}, true);
   if (!reference.stopped.empty()) {
-    throw std::runtime_error(fmt::format("the RK4 reference of {} at dt = {:.3g} s stopped: {}",
-                                         path, reference_config.dt(), reference.stopped));
+    throw std::runtime_error(fmt::format("the {} reference of {} at dt = {:.3g} s stopped: {}",
+                                         reference_config.method, path, reference_config.dt(),
+                                         reference.stopped));
   }
   // The scale of the energy lost: the most kinetic energy the reference had at a frame [J].
   double motion = *std::max_element(reference.kinetic.begin(), reference.kinetic.end());
@@ -271,7 +307,7 @@ std::vector<MethodRun> bake_off(const std::string& path, const MethodsOptions& o
   std::vector<MethodRun> runs;
   MethodRun ref_row{path, reference_config};
   ref_row.reference = true;
-  ref_row.steps = static_cast<long>(scene.frames) * per_frame_ref;
+  ref_row.steps = static_cast<long>(scene.frames) * reference_config.per_frame;
   ref_row.error = difference(finer, reference, scene.size);
   ref_row.worst_strain = reference.worst_strain;
   ref_row.energy_lost = 0.0;
@@ -282,7 +318,7 @@ std::vector<MethodRun> bake_off(const std::string& path, const MethodsOptions& o
   print_row(ref_row);
   runs.push_back(ref_row);
 
-  for (const Ladder& ladder : ladders(opt.quick)) {
+  for (const Ladder& ladder : ladders(opt.quick, opt.large)) {
     if (!engine_has(ladder.method)) continue;  // the local/global solver, before lesson 13
     const int base = ladder.from_limit ? advised_per_frame(scene, ladder.method) : 1;
     for (double factor : ladder.factors) {
@@ -438,8 +474,12 @@ int bench_methods(const MethodsOptions& opt) {
   std::vector<std::string> scenes = opt.scenes;
   if (scenes.empty()) {
     const fs::path lesson = fs::path(CLOTHLAB_SOURCE_DIR) / "lessons" / "12-xpbd";
-    for (const char* name :
-         {"bakeoff-hanging-sheet.toml", "bakeoff-gusty-flag.toml", "bakeoff-drape.toml"})
+    const auto names =
+        opt.large ? std::vector<std::string>{"bakeoff-large-sheet.toml", "bakeoff-large-flag.toml",
+                                             "bakeoff-large-drape.toml"}
+                  : std::vector<std::string>{"bakeoff-hanging-sheet.toml",
+                                             "bakeoff-gusty-flag.toml", "bakeoff-drape.toml"};
+    for (const std::string& name : names)
       scenes.push_back((lesson / name).string());
   }
   fmt::print(
@@ -500,6 +540,18 @@ void add_bench_methods_command(CLI::App& bench) {
                       "Plot file (.svg, .png or .pdf; default OUT/methods.svg)");
   methods->add_flag("--no-plot", options.no_plot, "Write the CSV and the script, draw nothing");
   methods->add_flag("--quick", options.quick, "Shorter ladders and a cheaper reference (tests)");
+  methods->add_flag("--large", options.large,
+                    "Lesson 12's cloths of real size (48 x 48 particles, a woven fabric's "
+                    "stiffness) instead of its three small ones; the reference takes minutes");
+  methods
+      ->add_option("--reference", options.reference,
+                   "The reference's method (default rk4): any method with a stability limit")
+      ->check(CLI::IsMember({"symplectic-euler", "rk4", "velocity-verlet", "midpoint"}));
+  methods
+      ->add_option("--reference-below", options.reference_below,
+                   "The reference's step: this many times below its advised limit (default "
+                   "128; 8 with --large; --quick 16, or 2 with --large)")
+      ->check(CLI::PositiveNumber);
   methods
       ->add_option("--min-seconds", options.min_seconds,
                    "Wall time [s] each run is repeated for; the fastest repeat is kept")

@@ -19,6 +19,21 @@ function(check_header csv expected)
   endif()
 endfunction()
 
+# read_methods_csv(CSV ROWS WITH_LOCAL_GLOBAL): checks the header of a `bench methods` CSV and
+# leaves its rows in `lines`, and in `rows_per_scene` the rows each scene has: ROWS, or
+# WITH_LOCAL_GLOBAL when the engine has the local/global solver (the command's output `out` names
+# it).
+macro(read_methods_csv csv rows with_local_global)
+  check_header(${csv} "scene,method,dt,substeps,iterations,steps,error,\
+worst_strain,energy_lost,wall_s_per_sim_s,stable")
+  file(STRINGS ${csv} lines)
+  list(POP_FRONT lines)
+  set(rows_per_scene ${rows})
+  if(out MATCHES "local-global")
+    set(rows_per_scene ${with_local_global})
+  endif()
+endmacro()
+
 # check_plot(SCRIPT SVG ERR): the plot script was written; the SVG was drawn, or, with no
 # matplotlib (and CLOTHLAB_REQUIRE_PLOT unset), the command's errors ERR say how to get it.
 function(check_plot script svg err)

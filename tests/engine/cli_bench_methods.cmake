@@ -9,17 +9,9 @@ include(${CMAKE_CURRENT_LIST_DIR}/cli_bench_checks.cmake)
 file(REMOVE_RECURSE ${WORK})
 file(MAKE_DIRECTORY ${WORK})
 run_bench("bench methods" bench methods --quick --min-seconds 0.001 --out out)
-check_header(${WORK}/out/methods.csv "scene,method,dt,substeps,iterations,steps,error,\
-worst_strain,energy_lost,wall_s_per_sim_s,stable")
-file(STRINGS ${WORK}/out/methods.csv lines)
-list(POP_FRONT lines header)
-
 # Per scene, in --quick: the reference, symplectic Euler x 3 steps, RK4 x 2, implicit Euler x 3,
 # XPBD x 5 settings, and the local/global solver x 2 when the engine has it.
-set(rows_per_scene 14)
-if(out MATCHES "local-global")
-  set(rows_per_scene 16)
-endif()
+read_methods_csv(${WORK}/out/methods.csv 14 16)
 foreach(scene bakeoff-hanging-sheet bakeoff-gusty-flag bakeoff-drape)
   set(rows 0)
   set(self_difference "")
