@@ -19,12 +19,14 @@ Options follow the command, each after a '|':
     | shape only                     every number in shape only (figures re-measured elsewhere).
     | checked with: COMMAND          run this quicker command instead, which prints the same
                                      numbers (say so in the text).
+    | in: FOLDER                     run it beside the files of this folder of the project (the
+                                     scenes a README example names as if they were at hand).
 
 The command runs once, from a folder where `./build` is the build and `lessons` the lessons, and
 every block that names it is checked against its output. Each quoted line must match an output
 line, in order: the same words (blanks collapsed), and every number the same to the digits the
 block shows (a quoted 0.9320 matches a printed 0.93204, not 0.9330). A line of "..." stands for
-lines left out.
+lines left out; a line that starts with "$ " is the command typed, not its output.
 
     check_quoted_outputs.py --source ROOT --build BUILD --work DIR [--timeout S] DOCUMENT...
 """
@@ -61,7 +63,7 @@ def half_unit(quoted):
 class Block:
     def __init__(self, document, line, command, options, lines):
         self.document, self.line, self.command, self.lines = document, line, command, lines
-        self.timing, self.shape_only, self.run = [], False, command
+        self.timing, self.shape_only, self.run, self.folder = [], False, command, ""
         for option in options:
             key, _, value = option.partition(":")
             key, value = key.strip(), value.strip()
@@ -73,9 +75,11 @@ class Block:
                 self.shape_only = True
             elif key == "checked with":
                 self.run = value
+            elif key == "in":
+                self.folder = value
             else:
                 raise ValueError(f"{self.where()}: unknown option {key!r} (expected timing:, "
-                                 "shape only or checked with:)")
+                                 "shape only, checked with: or in:)")
 
     def where(self, offset=0):
         return f"{self.document}:{self.line + offset}"
@@ -146,7 +150,7 @@ def check_block(block, output):
     cursor = 0
     timing = block.timing_places()
     for offset, (text, places) in enumerate(zip(block.lines, timing)):
-        if not text.strip() or text.strip() in ("...", "…"):
+        if not text.strip() or text.strip() in ("...", "…") or text.startswith("$ "):
             continue
         want = skeleton(text)
         quoted = numbers(text)
@@ -184,12 +188,16 @@ def main():
     args = parser.parse_args()
 
     # The commands read as the lessons write them, from the project's root: ./build/..., lessons/.
-    os.makedirs(args.work, exist_ok=True)
-    for name, target in (("build", args.build), ("lessons", os.path.join(args.source, "lessons"))):
-        link = os.path.join(args.work, name)
-        if os.path.islink(link):
-            os.remove(link)
-        os.symlink(os.path.abspath(target), link)
+    def prepare(work, files):
+        os.makedirs(work, exist_ok=True)
+        for name, target in files:
+            link = os.path.join(work, name)
+            if os.path.islink(link):
+                os.remove(link)
+            os.symlink(os.path.abspath(target), link)
+        return work
+
+    prepare(args.work, (("build", args.build), ("lessons", os.path.join(args.source, "lessons"))))
 
     try:
         blocks = [b for d in args.documents for b in read_blocks(args.source, d)]
@@ -203,20 +211,30 @@ def main():
 
     outputs = {}
     problems = []
-    for command in dict.fromkeys(b.run for b in blocks):
+    for command, folder in dict.fromkeys((b.run, b.folder) for b in blocks):
+        work = args.work
+        if folder:
+            # The folder's files linked into a work folder of their own, beside ./build.
+            at = os.path.join(args.source, folder)
+            if not os.path.isdir(at):
+                problems.append(f"in: {folder} is not a folder of the project")
+                continue
+            files = [(f, os.path.join(at, f)) for f in sorted(os.listdir(at))]
+            work = prepare(os.path.join(args.work, folder.replace("/", "_")),
+                           files + [("build", args.build)])
         try:
-            done = subprocess.run(shlex.split(command), cwd=args.work, capture_output=True,
+            done = subprocess.run(shlex.split(command), cwd=work, capture_output=True,
                                   text=True, timeout=args.timeout)
         except (OSError, subprocess.TimeoutExpired) as error:
             problems.append(f"`{command}` could not run: {error}")
             continue
         if done.returncode != 0:
             problems.append(f"`{command}` exited with {done.returncode}:\n{done.stderr[-2000:]}")
-        outputs[command] = (done.stdout + done.stderr).split("\n")
+        outputs[command, folder] = (done.stdout + done.stderr).split("\n")
 
     for block in blocks:
-        if block.run in outputs:
-            problems += check_block(block, outputs[block.run])
+        if (block.run, block.folder) in outputs:
+            problems += check_block(block, outputs[block.run, block.folder])
 
     lines = sum(len([t for t in b.lines if t.strip()]) for b in blocks)
     print(f"{len(blocks)} quoted outputs ({lines} lines) from {len(outputs)} commands checked")
