@@ -19,6 +19,7 @@ Options follow the command, each after a '|':
     | shape only                     every number in shape only (figures re-measured elsewhere).
     | checked with: COMMAND          run this quicker command instead, which prints the same
                                      numbers (say so in the text).
+    | exit: N                        the command's exit code (0 unless given).
     | in: FOLDER                     run it beside the files of this folder of the project (the
                                      scenes a README example names as if they were at hand).
 
@@ -38,6 +39,7 @@ import re
 import shlex
 import subprocess
 import sys
+from concurrent.futures import ThreadPoolExecutor
 from decimal import Decimal
 
 NUMBER = re.compile(r"[+-]?(?:\d+(?:\.\d+)?|\.\d+)(?:[eE][+-]?\d+)?")
@@ -64,6 +66,7 @@ class Block:
     def __init__(self, document, line, command, options, lines):
         self.document, self.line, self.command, self.lines = document, line, command, lines
         self.timing, self.shape_only, self.run, self.folder = [], False, command, ""
+        self.exit = 0
         for option in options:
             key, _, value = option.partition(":")
             key, value = key.strip(), value.strip()
@@ -75,11 +78,13 @@ class Block:
                 self.shape_only = True
             elif key == "checked with":
                 self.run = value
+            elif key == "exit":
+                self.exit = int(value)
             elif key == "in":
                 self.folder = value
             else:
                 raise ValueError(f"{self.where()}: unknown option {key!r} (expected timing:, "
-                                 "shape only, checked with: or in:)")
+                                 "shape only, checked with:, exit: or in:)")
 
     def where(self, offset=0):
         return f"{self.document}:{self.line + offset}"
@@ -211,14 +216,14 @@ def main():
 
     outputs = {}
     problems = []
-    for command, folder in dict.fromkeys((b.run, b.folder) for b in blocks):
+    def run(key):
+        command, folder, code = key
         work = args.work
         if folder:
             # The folder's files linked into a work folder of their own, beside ./build.
             at = os.path.join(args.source, folder)
             if not os.path.isdir(at):
-                problems.append(f"in: {folder} is not a folder of the project")
-                continue
+                return [f"in: {folder} is not a folder of the project"], None
             files = [(f, os.path.join(at, f)) for f in sorted(os.listdir(at))]
             work = prepare(os.path.join(args.work, folder.replace("/", "_")),
                            files + [("build", args.build)])
@@ -226,11 +231,20 @@ def main():
             done = subprocess.run(shlex.split(command), cwd=work, capture_output=True,
                                   text=True, timeout=args.timeout)
         except (OSError, subprocess.TimeoutExpired) as error:
-            problems.append(f"`{command}` could not run: {error}")
-            continue
-        if done.returncode != 0:
-            problems.append(f"`{command}` exited with {done.returncode}:\n{done.stderr[-2000:]}")
-        outputs[command, folder] = (done.stdout + done.stderr).split("\n")
+            return [f"`{command}` could not run: {error}"], None
+        trouble = []
+        if done.returncode != code:
+            trouble.append(f"`{command}` exited with {done.returncode}, not {code}:\n"
+                           f"{done.stderr[-2000:]}")
+        return trouble, (done.stdout + done.stderr).split("\n")
+
+    # Two commands at a time: the lesson programs run one thread each.
+    keys = list(dict.fromkeys((b.run, b.folder, b.exit) for b in blocks))
+    with ThreadPoolExecutor(max_workers=2) as pool:
+        for (command, folder, _), (trouble, output) in zip(keys, pool.map(run, keys)):
+            problems += trouble
+            if output is not None:
+                outputs[command, folder] = output
 
     for block in blocks:
         if (block.run, block.folder) in outputs:
