@@ -1,6 +1,7 @@
 // local_global.hpp: fast mass-spring simulation by a local/global solver (lesson 13).
 //
-// Liu, O'Brien, Kavan, Kim and Kavan, "Fast Simulation of Mass-Spring Systems" (2013).
+// Liu, Bargteil, O'Brien and Kavan, "Fast Simulation of Mass-Spring Systems", ACM Transactions
+// on Graphics 32(6) (SIGGRAPH Asia 2013).
 //
 // Implicit Euler is a minimisation (lesson 08 took one linearised step of it instead): with
 // y = x_n + h v_n the place inertia alone would carry the particles, the new positions minimise
