@@ -353,6 +353,50 @@ Snapshot exercise_files(const fs::path& dir) {
   return files;
 }
 
+// The student's live pages (engine/web/), rebuilt on each save where the build can make them
+// (it found emscripten when it was configured), and only for the exercises those pages are built
+// from: the course's exercises/, not a folder given with --exercises. Says where they are, or
+// why they could not be rebuilt.
+void rebuild_student_pages(const Options& o) {
+#if CLOTHLAB_WEB_STUDENT
+  if (!o.exercises.empty()) return;
+  const std::string build = build_dir();
+  if (!fs::exists(fs::path(build) / "web" / "CMakeCache.txt")) {
+    // Never built here: the first build takes many minutes, too long to start on a save.
+    fmt::print(
+        "\n(your live pages are not built: `cmake --build {} --target web-student` builds "
+        "them once, and watch then rebuilds them each time you save)\n",
+        relative_path(build));
+    return;
+  }
+  fmt::print("\nrebuilding your live pages (cmake --build {} --target web-student) ...\n",
+             relative_path(build));
+  std::fflush(stdout);
+  const Clock::time_point start = Clock::now();
+  const ProcessResult r =
+      run_process({CLOTHLAB_CMAKE_COMMAND, "--build", build, "--target", "web-student"}, 900);
+  const double seconds = std::chrono::duration<double>(Clock::now() - start).count();
+  if (r.interrupted) return;
+  if (r.exit_code == 0 && r.signal == 0 && !r.timed_out) {
+    fmt::print(
+        "your live pages, rebuilt in {:.1f} s: open {}/pages/NN-name-student.html in a "
+        "browser (reload it if it is open)\n",
+        seconds, relative_path(build));
+    return;
+  }
+  // The build's last lines: the compiler's error, or what else stopped it.
+  std::string tail = r.output;
+  size_t at = tail.size();
+  for (int lines = 0; lines < 12 && at > 0; ++lines)
+    at = tail.rfind('\n', at - 1);
+  if (at != std::string::npos && at > 0) tail = tail.substr(at + 1);
+  fmt::print("your live pages could not be rebuilt ({}):\n{}\n",
+             r.timed_out ? "the build took too long" : "the build failed", indent(tail, "  "));
+#else
+  (void)o;  // no emscripten when the build was configured: no live pages to rebuild
+#endif
+}
+
 // `clothlab watch`: grades, then grades again each time an exercise file is saved.
 void watch(Options o) {
   const fs::path dir =
@@ -372,6 +416,7 @@ void watch(Options o) {
       if (e.get_exit_code() == kExitInterrupted) throw;  // interrupted while grading
       // Anything else the grader could not do is said; the next save may mend it.
     }
+    rebuild_student_pages(o);
     if (o.rounds > 0 && round >= o.rounds) return;
     fmt::print("\nwaiting for a change in {}/ (Ctrl-C to stop)\n", relative_path(dir.string()));
     std::fflush(stdout);
