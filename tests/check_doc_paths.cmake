@@ -14,7 +14,7 @@ foreach(doc ${docs})
     # A student release leaves out the solutions, the hidden grading tests and the mistakes
     # planted in copies of the solutions on purpose.
     set(left_out FALSE)
-    foreach(withheld solutions tests/grade-hidden tests/grade/planted)
+    foreach(withheld solutions tests/grade-hidden tests/grade/harness/planted)
       if(path MATCHES "^${withheld}(/|$)" AND NOT EXISTS ${ROOT}/${withheld})
         set(left_out TRUE)
       endif()

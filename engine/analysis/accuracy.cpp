@@ -55,7 +55,7 @@ World DampedOscillatorProblem::make_world(const std::string& integrator) const {
   world.particles.inv_m[0] = 0.0;
   world.particles.add(Vec3(1.0 + kStretch, 0.0, 0.0), Vec3::Zero(), mass_);
   SpringSet spring;
-  spring.add(0, 1, ks_, kd_, 1.0, world.particles.x);
+  spring.add(0, 1, ks_, kd_, 1.0);
   world.force_effects.push_back(std::make_unique<SpringDampers>("springs", std::move(spring)));
   world.integrator = integrator_called(integrator);
   // The linear solves of implicit Euler must not limit its accuracy here.

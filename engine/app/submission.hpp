@@ -5,8 +5,8 @@
 // exercises/), a shipped stub stands in for each file the submission lacks, and a small CMake
 // project that the build generated next to clothlab (grade-kit/) compiles those files alone and
 // links them with the engine's objects the project's build already made, into the kernels
-// program the grading binary calls (grade-kernels, see tests/grade/kernel_wire.hpp). Nothing of
-// the submission runs here: it is only compiled, and no test is linked with it.
+// program the grading binary calls (grade-kernels, see tests/grade/harness/kernel_wire.hpp).
+// Nothing of the submission runs here: it is only compiled, and no test is linked with it.
 #pragma once
 
 #include <memory>

@@ -49,6 +49,16 @@ template <class Kernel>
   }
 }
 
+// A contact's response on particles [begin, end), the lecture's loop (Ground::collide,
+// Sphere::collide) called from here with `flatten`, so that the loop and the exercise's
+// collision_response are inlined at link time. GCC otherwise calls collision_response once per
+// particle in contact: perf put 10 % of a step with a ground in that call (SPEED.md).
+template <class Collider>
+[[gnu::flatten]] void collide_range(const Collider& collider, Particles& p, Index begin,
+                                    Index end) {
+  collider.collide(p, begin, end);
+}
+
 // An Euler method's move of particles [begin, end) (FastEngine::MoveRange), from the copies
 // when it has them. The kernels come wrapped in lambdas, each a type of its own, so that each
 // loop is compiled for its kernel, inlined.
@@ -136,8 +146,8 @@ BackendStep FastEngine::step(World& world, double dt) {
     move_then_contacts = [&](Index begin, Index end, const Copies* copies) {
       move(begin, end, copies);
       for (const Contact& contact : contacts_) {
-        if (contact.ground) contact.ground->collide(p, begin, end);
-        if (contact.sphere) contact.sphere->collide(p, begin, end);
+        if (contact.ground) collide_range(*contact.ground, p, begin, end);
+        if (contact.sphere) collide_range(*contact.sphere, p, begin, end);
       }
     };
     moves = &move_then_contacts;

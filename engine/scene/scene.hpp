@@ -82,7 +82,6 @@ struct Scene {
   std::optional<ClothGrid> cloth;
   std::optional<Rope> rope;
   std::optional<SolidLattice> solid;
-  SpringSet springs;               // structural, shear and one-by-one springs: the "springs" effect
   std::vector<PinPath> pin_paths;  // the bodies' moving pins: the "moving_pins" effect
 
   long step_count() const;  // steps needed to cover `duration`

@@ -510,6 +510,29 @@ void read_solid(SceneTable& t, Scene& scene) {
   scene.world.triangles.insert(scene.world.triangles.end(), surface.begin(), surface.end());
 }
 
+// The "springs" effect: structural, shear and one-by-one springs make one effect, first in the
+// list, so that reports read in the lessons' order: springs, bending, gravity, ... It is made by
+// the first table that adds a spring ([[spring]] or [springs], which always adds some), and those
+// tables add to it directly; the post-step effects that change these springs are given it when
+// they are made.
+SpringDampers* find_springs_effect(Scene& scene) {
+  auto& effects = scene.world.force_effects;
+  if (effects.empty() || effects.front()->name() != "springs") return nullptr;
+  return static_cast<SpringDampers*>(effects.front().get());
+}
+
+bool has_springs(Scene& scene) {
+  const SpringDampers* effect = find_springs_effect(scene);
+  return effect && effect->springs().size() > 0;
+}
+
+SpringDampers& springs_effect(Scene& scene) {
+  if (SpringDampers* effect = find_springs_effect(scene)) return *effect;
+  auto& effects = scene.world.force_effects;
+  effects.insert(effects.begin(), std::make_unique<SpringDampers>("springs", SpringSet{}));
+  return static_cast<SpringDampers&>(*effects.front());
+}
+
 // [[spring]]: one spring-damper between two particles given by index (lesson 02).
 void read_spring(SceneTable& t, Scene& scene) {
   const Particles& p = scene.world.particles;
@@ -522,11 +545,15 @@ void read_spring(SceneTable& t, Scene& scene) {
     t.fail("j", fmt::format("the spring joins particle {} to itself; expected i != j", i));
   const double ks = t.required_number("ks", Range::non_negative("N/m"));
   const double kd = t.number("kd", Range::non_negative("N s/m"), 0.0);
-  const double l0 = t.number("l0", Range::non_negative("m"), -1.0);  // default: distance now
-  scene.springs.add(i, j, ks, kd, l0, p.x);
+  SpringSet& springs = springs_effect(scene).springs();
+  // Without l0 the spring is at rest as the particles stand: its rest length is their distance.
+  if (t.has("l0"))
+    springs.add(i, j, ks, kd, t.required_number("l0", Range::non_negative("m")));
+  else
+    springs.add_at_rest(i, j, ks, kd, p.x);
   // The strain (l - l0) / l0 divides by l0: a spring of no rest length has none, and its force
   // ks l pulls its ends onto each other.
-  if (scene.springs.l0(scene.springs.size() - 1) == 0.0) {
+  if (springs.l0(springs.size() - 1) == 0.0) {
     const std::string what =
         t.has("l0") ? fmt::format("{} has l0 = 0", t.display_name())
                     : fmt::format(
@@ -574,25 +601,26 @@ void read_springs(SceneTable& t, Scene& scene) {
   const double shear_ks = t.number("shear_ks", Range::non_negative("N/m"), ks);
   const double shear_kd = t.number("shear_kd", Range::non_negative("N s/m"), kd);
   const Matrix3X& x = scene.world.particles.x;
-  const size_t from = scene.springs.size();  // after the [[spring]] tables' springs
+  SpringSet& springs = springs_effect(scene).springs();
+  const size_t from = springs.size();  // after the [[spring]] tables' springs
   if (scene.rope)
-    add_spring_family(scene.springs, rope_pairs(scene.rope->count), scene.rope->first, ks, kd, x);
+    add_spring_family(springs, rope_pairs(scene.rope->count), scene.rope->first, ks, kd, x);
   if (scene.cloth) {
     const ClothGrid& g = *scene.cloth;
-    add_spring_family(scene.springs, structural_pairs(g.rows, g.cols), g.first, ks, kd, x);
-    add_spring_family(scene.springs, shear_pairs(g.rows, g.cols), g.first, shear_ks, shear_kd, x);
+    add_spring_family(springs, structural_pairs(g.rows, g.cols), g.first, ks, kd, x);
+    add_spring_family(springs, shear_pairs(g.rows, g.cols), g.first, shear_ks, shear_kd, x);
   }
   if (scene.solid) {
     // The cell's edges take ks and kd; both kinds of diagonal resist shear, and take the shear
     // constants, as the cloth's diagonals do.
     const SolidLattice& g = *scene.solid;
-    add_spring_family(scene.springs, solid_structural_pairs(g.nx, g.ny, g.nz), g.first, ks, kd, x);
-    add_spring_family(scene.springs, solid_face_diagonal_pairs(g.nx, g.ny, g.nz), g.first, shear_ks,
+    add_spring_family(springs, solid_structural_pairs(g.nx, g.ny, g.nz), g.first, ks, kd, x);
+    add_spring_family(springs, solid_face_diagonal_pairs(g.nx, g.ny, g.nz), g.first, shear_ks,
                       shear_kd, x);
-    add_spring_family(scene.springs, solid_body_diagonal_pairs(g.nx, g.ny, g.nz), g.first, shear_ks,
+    add_spring_family(springs, solid_body_diagonal_pairs(g.nx, g.ny, g.nz), g.first, shear_ks,
                       shear_kd, x);
   }
-  warn_zero_rest_lengths(t, scene, scene.springs, from);
+  warn_zero_rest_lengths(t, scene, springs, from);
 }
 
 // [bending]: flexion springs two apart, with their own constants (lesson 04).
@@ -715,25 +743,6 @@ ContactMaterial read_material(SceneTable& t) {
                                m.mu_d, m.mu_s));
   }
   return m;
-}
-
-// The "springs" effect: structural, shear and one-by-one springs make one effect, built once all
-// are known (their tables come before any that needs the effect) and first in the list, so that
-// reports read in the lessons' order: springs, bending, gravity, ... The post-step effects that
-// change these springs are given it when they are made.
-bool has_springs(const Scene& scene) {
-  const auto& effects = scene.world.force_effects;
-  return scene.springs.size() > 0 || (!effects.empty() && effects.front()->name() == "springs");
-}
-
-SpringDampers& springs_effect(Scene& scene) {
-  auto& effects = scene.world.force_effects;
-  if (effects.empty() || effects.front()->name() != "springs") {
-    effects.insert(effects.begin(),
-                   std::make_unique<SpringDampers>("springs", std::move(scene.springs)));
-    scene.springs = SpringSet{};
-  }
-  return static_cast<SpringDampers&>(*effects.front());
 }
 
 // [strain_limit]: springs shortened back to a largest strain after each step (lesson 09).
@@ -1034,7 +1043,6 @@ void finish_scene(Scene& scene, const std::function<void(const std::string&)>& f
         "the scene has no particles; expected [[particle]] tables, a [rope], a [cloth] or a "
         "[solid]");
   }
-  if (scene.springs.size() > 0) springs_effect(scene);
   // The pins that move, last: where a path puts a particle is where it is after the step.
   if (!scene.pin_paths.empty()) {
     auto pins = std::make_unique<MovingPins>(std::move(scene.pin_paths));

@@ -43,7 +43,7 @@ World one_spring(double ks, double kd, double l0, const Vec3& bob, bool gravity)
   pin(p, p.add(Vec3::Zero(), Vec3::Zero(), 1.0));  // 1/m = 0 and v = 0: it never moves
   p.add(bob, Vec3::Zero(), m);
   SpringSet springs;
-  springs.add(0, 1, ks, kd, l0, p.x);
+  springs.add(0, 1, ks, kd, l0);
   world.force_effects.push_back(std::make_unique<SpringDampers>("springs", std::move(springs)));
   if (gravity) world.force_effects.push_back(std::make_unique<UniformGravity>(Vec3(0, -g, 0)));
   return world;
@@ -66,8 +66,8 @@ void period_table() {
   fmt::print("   {:>8}  {:>12}  {:>12}  {:>12}  {:>12}\n", "ks [N/m]", "2pi sqrt(m/k)",
              "measured T", "m g / ks [m]", "centre [m]");
   for (const double ks : {25.0, 100.0, 400.0}) {
-    World world = one_spring(ks, 0.0, -1.0, Vec3(0, -1, 0), true);  // l0 < 0: l0 = 1 m as built
-    const double y_eq = -1.0 - m * g / ks;                          // equilibrium height [m]
+    World world = one_spring(ks, 0.0, 1.0, Vec3(0, -1, 0), true);  // released at rest length
+    const double y_eq = -1.0 - m * g / ks;                         // equilibrium height [m]
     std::vector<double> crossings;  // times the bob passes y_eq going down [s]
     double y_low = 0.0, y_high = -1.0;
     double y_prev = world.particles.x(1, 1);

@@ -141,7 +141,7 @@ World spring_world(std::string_view method, double m0, double m1, double ks, dou
   world.particles.add(Vec3(1.0 + stretch, 0.0, 0.0), Vec3::Zero(), m1);
   if (m0 == 0.0) pin(world.particles, 0);
   SpringSet springs;
-  springs.add(0, 1, ks, kd, 1.0, world.particles.x);
+  springs.add(0, 1, ks, kd, 1.0);
   world.force_effects.push_back(std::make_unique<SpringDampers>("springs", std::move(springs)));
   world.integrator = make_integrator(method);
   return world;

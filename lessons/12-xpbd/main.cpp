@@ -47,7 +47,7 @@ World chain(int links, double m, double ks, double kd) {
   SpringSet springs;
   for (int k = 1; k <= links; ++k) {
     world.particles.add(Vec3(0.0, -k, 0.0), Vec3::Zero(), m);
-    springs.add(k - 1, k, ks, kd, 1.0, world.particles.x);
+    springs.add(k - 1, k, ks, kd, 1.0);
   }
   world.force_effects.push_back(std::make_unique<SpringDampers>("springs", std::move(springs)));
   world.force_effects.push_back(std::make_unique<UniformGravity>(Vec3(0.0, -kG, 0.0)));

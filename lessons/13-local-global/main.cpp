@@ -72,7 +72,7 @@ Vec3 pendulum_after_one_second(std::unique_ptr<Integrator> integrator, double dt
   pin(world.particles, 0);  // the anchor
   world.particles.add(Vec3(1.0, 0.0, 0.0), Vec3::Zero(), 1.0);
   SpringSet springs;
-  springs.add(0, 1, 1000.0, 0.0, 1.0, world.particles.x);
+  springs.add(0, 1, 1000.0, 0.0, 1.0);
   world.force_effects.push_back(std::make_unique<SpringDampers>("springs", std::move(springs)));
   world.force_effects.push_back(std::make_unique<UniformGravity>(Vec3(0.0, -9.8, 0.0)));
   world.integrator = std::move(integrator);

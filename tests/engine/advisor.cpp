@@ -121,7 +121,7 @@ TEST_CASE("advisor: Gershgorin's bound is exact for one spring and a free pair")
   pair.particles.add(Vec3::Zero(), Vec3::Zero(), 2.0);
   pair.particles.add(Vec3(1, 0, 0), Vec3::Zero(), 2.0);
   clothlab::SpringSet spring;
-  spring.add(0, 1, 50.0, 3.0, -1.0, pair.particles.x);
+  spring.add_at_rest(0, 1, 50.0, 3.0, pair.particles.x);
   pair.force_effects.push_back(
       std::make_unique<clothlab::SpringDampers>("springs", std::move(spring)));
   pair.integrator = clothlab::make_integrator("symplectic-euler");
@@ -235,7 +235,7 @@ TEST_CASE("guard: a slow energy runaway stops long before the speed bound") {
   world.particles.inv_m[0] = 0.0;
   world.particles.add(Vec3(0.3, 0.0, 0.0), Vec3::Zero(), 1.0);
   clothlab::SpringSet spring;
-  spring.add(0, 1, 100.0, 0.0, 0.0, world.particles.x);
+  spring.add(0, 1, 100.0, 0.0, 0.0);
   world.force_effects.push_back(
       std::make_unique<clothlab::SpringDampers>("springs", std::move(spring)));
   world.integrator = clothlab::make_integrator("explicit-euler");

@@ -5,6 +5,7 @@
 #include <cstring>
 #include <limits>
 #include <random>
+#include <stdexcept>
 #include <string>
 
 #include "clothlab/bodies/cloth.hpp"
@@ -247,4 +248,67 @@ duration = 1
   // Air pushes along the normal only: a flat sheet falling straight down is not pushed sideways.
   CHECK(std::abs(airy.world.momentum().x()) < 1e-9);
   CHECK(std::abs(airy.world.momentum().z()) < 1e-9);
+}
+
+TEST_CASE("springs: one effect owns the [[spring]] tables' springs and the body's, in that order") {
+  // Particles 0 and 1 are 0.3 m apart, 1 and 2 are 0.5 m apart: the spring without l0 rests at
+  // that distance, the one with l0 at its own. The rope of 3 particles adds 2 springs after them.
+  clothlab::Scene scene = clothlab::parse_scene(R"(
+[[particle]]
+position = [0, 0, 0]
+mass = 1
+[[particle]]
+position = [0.3, 0, 0]
+mass = 1
+[[particle]]
+position = [0.3, 0.5, 0]
+mass = 1
+[[spring]]
+i = 0
+j = 1
+ks = 100
+l0 = 0.25
+[[spring]]
+i = 1
+j = 2
+ks = 50
+[rope]
+start = [0, 2, 0]
+end = [1, 2, 0]
+particles = 3
+mass = 1
+[springs]
+ks = 10
+[integrator]
+dt = 0.001
+duration = 0.01
+)",
+                                                "owner.toml");
+  REQUIRE(!scene.world.force_effects.empty());
+  CHECK(scene.world.force_effects.front()->name() == "springs");
+  const clothlab::SpringDampers* effect = clothlab::find_spring_effect(scene.world, "springs");
+  REQUIRE(effect != nullptr);
+  const clothlab::SpringSet& s = effect->springs();
+  REQUIRE(s.size() == 4);
+  CHECK(s.l0(0) == 0.25);
+  CHECK(s.l0(1) == doctest::Approx(0.5).epsilon(1e-15));
+  CHECK(s.ks(2) == 10.0);
+  CHECK(s.l0(2) == doctest::Approx(0.5).epsilon(1e-15));  // the rope's 1 m in 2 segments
+  for (size_t k = 0; k < s.size(); ++k)
+    CHECK(s.l_built(k) == s.l0(k));
+}
+
+TEST_CASE("springs: a rest length is given (l0 >= 0) or measured, never guessed from a sign") {
+  clothlab::Matrix3X x(3, 2);
+  x << 0.0, 3.0, 0.0, 4.0, 0.0, 0.0;
+  clothlab::SpringSet s;
+  s.add_at_rest(0, 1, 1.0, 0.0, x);  // |(3, 4, 0)| = 5 m
+  s.add(0, 1, 1.0, 0.0, 0.0);        // no rest length: allowed (the scene reader warns)
+  CHECK(s.l0(0) == 5.0);
+  CHECK(s.l0(1) == 0.0);
+  // A negative rest length is a mistake, not a request to measure one.
+  CHECK_THROWS_AS(s.add(0, 1, 1.0, 0.0, -1.0), std::invalid_argument);
+  CHECK_THROWS_AS(s.add(0, 1, 1.0, 0.0, std::numeric_limits<double>::quiet_NaN()),
+                  std::invalid_argument);
+  CHECK(s.size() == 2);
 }

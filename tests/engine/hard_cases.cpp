@@ -802,7 +802,7 @@ TEST_CASE("hard case: a tearing cascade tears the same springs whatever their or
     clothlab::SpringSet out;
     for (size_t k : order) {
       REQUIRE(s.l_built(k) == s.l0(k));  // as built: add() gives l_built = l0
-      out.add(s.i(k), s.j(k), s.ks(k), s.kd(k), s.l0(k), clothlab::Matrix3X());
+      out.add(s.i(k), s.j(k), s.ks(k), s.kd(k), s.l0(k));
     }
     s = out;
   };

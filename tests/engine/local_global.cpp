@@ -62,10 +62,9 @@ World patch(double ks, double kd) {
   const auto at = [](int r, int c) { return static_cast<Index>(3 * r + c); };
   for (int r = 0; r < 3; ++r) {
     for (int c = 0; c < 3; ++c) {
-      if (c + 1 < 3) springs.add(at(r, c), at(r, c + 1), ks, kd, 1.0, world.particles.x);
-      if (r + 1 < 3) springs.add(at(r, c), at(r + 1, c), ks, kd, 1.0, world.particles.x);
-      if (r + 1 < 3 && c + 1 < 3)
-        springs.add(at(r, c), at(r + 1, c + 1), ks, kd, std::sqrt(2.0), world.particles.x);
+      if (c + 1 < 3) springs.add(at(r, c), at(r, c + 1), ks, kd, 1.0);
+      if (r + 1 < 3) springs.add(at(r, c), at(r + 1, c), ks, kd, 1.0);
+      if (r + 1 < 3 && c + 1 < 3) springs.add(at(r, c), at(r + 1, c + 1), ks, kd, std::sqrt(2.0));
     }
   }
   world.force_effects.push_back(
@@ -327,7 +326,7 @@ TEST_CASE("local-global: coincident ends give a finite step") {
   world.particles.add(Vec3::Zero(), Vec3::Zero(), 1.0);
   world.particles.add(Vec3::Zero(), Vec3::Zero(), 1.0);
   clothlab::SpringSet springs;
-  springs.add(0, 1, 100.0, 0.0, 1.0, world.particles.x);
+  springs.add(0, 1, 100.0, 0.0, 1.0);
   world.force_effects.push_back(
       std::make_unique<clothlab::SpringDampers>("springs", std::move(springs)));
   use_local_global(world, 5);

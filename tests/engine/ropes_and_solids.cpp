@@ -142,7 +142,7 @@ TEST_CASE("strain limiting: a correction between two free particles keeps moment
   w.particles.add(Vec3(0.0, 0.0, 0.0), Vec3(1.0, -2.0, 0.5), 1.0);
   w.particles.add(Vec3(1.2, 1.6, 0.0), Vec3(-0.3, 0.4, 2.0), 3.0);
   clothlab::SpringSet s;
-  s.add(0, 1, 10.0, 0.0, 1.0, w.particles.x);
+  s.add(0, 1, 10.0, 0.0, 1.0);
   w.force_effects.push_back(std::make_unique<clothlab::SpringDampers>("springs", s));
   clothlab::StrainLimiting limiter(*clothlab::find_spring_effect(w, "springs"), {0.1, 1.0}, 10);
   const Vec3 momentum = w.momentum();

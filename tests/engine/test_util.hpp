@@ -65,7 +65,7 @@ inline clothlab::World spring_pair(double m0, double m1, double ks, double kd, d
   }
   world.particles.add(clothlab::Vec3(1.0 + x0, 0.0, 0.0), clothlab::Vec3(v0, 0.0, 0.0), m1);
   clothlab::SpringSet springs;
-  springs.add(0, 1, ks, kd, 1.0, world.particles.x);
+  springs.add(0, 1, ks, kd, 1.0);
   world.force_effects.push_back(
       std::make_unique<clothlab::SpringDampers>("springs", std::move(springs)));
   return world;

@@ -46,7 +46,7 @@ World hanging_chain(int links, double m, double ks, double kd, double stretch = 
   clothlab::SpringSet springs;
   for (int k = 1; k <= links; ++k) {
     world.particles.add(Vec3(0.0, -k * (1.0 + stretch), 0.0), Vec3::Zero(), m);
-    springs.add(k - 1, k, ks, kd, 1.0, world.particles.x);
+    springs.add(k - 1, k, ks, kd, 1.0);
   }
   world.force_effects.push_back(
       std::make_unique<clothlab::SpringDampers>("springs", std::move(springs)));

@@ -134,9 +134,9 @@ TEST_CASE("fast path: every change of a spring set's ends or constants moves its
   clothlab::SpringSet s;
   const clothlab::Matrix3X x = clothlab::Matrix3X::Random(3, 4);
   const unsigned long empty = s.version();
-  s.add(0, 1, 10.0, 0.5, -1.0, x);
-  s.add(1, 2, 10.0, 0.5, -1.0, x);
-  s.add(2, 3, 10.0, 0.5, -1.0, x);
+  s.add_at_rest(0, 1, 10.0, 0.5, x);
+  s.add_at_rest(1, 2, 10.0, 0.5, x);
+  s.add_at_rest(2, 3, 10.0, 0.5, x);
   unsigned long seen = s.version();
   CHECK(seen != empty);
   // Each of these changes what a description of the set holds: each moves the version.
@@ -615,7 +615,7 @@ TEST_CASE("fast path: a set changed in place, or with no runs, still gives the r
     std::shuffle(order.begin(), order.end(), std::mt19937(7));
     clothlab::SpringSet out;
     for (size_t k : order)
-      out.add(s.i(k), s.j(k), s.ks(k), s.kd(k), s.l0(k), w->particles.x);
+      out.add(s.i(k), s.j(k), s.ks(k), s.kd(k), s.l0(k));
     s = out;
     for (size_t k = 0; k < s.size(); k += 2)
       s.set_ends(k, s.j(k), s.i(k));

@@ -3,12 +3,13 @@
 // doctest runs all cases in one process, so one crash or endless loop would lose every grade
 // after it. The grader therefore lists the cases of a grading binary, then runs each in its own
 // process group with a real timeout, and reads the line protocol the binary's "clothlab"
-// reporter writes to a pipe of its own (protocol.hpp; tests/grade/grade_main.cpp describes it).
+// reporter writes to a pipe of its own (protocol.hpp; tests/grade/harness/grade_main.cpp describes
+// it).
 //
 // The grading binary (grade-cases) holds the tests but not the exercise kernels: it calls them in
 // a kernels process (grade-kernels-reference, -stubs, or a submission's), which only computes and
-// cannot reach the pipe the verdicts go through (tests/grade/kernel_wire.hpp). A submission's
-// kernels run in a sandbox.
+// cannot reach the pipe the verdicts go through (tests/grade/harness/kernel_wire.hpp). A
+// submission's kernels run in a sandbox.
 #pragma once
 
 #include <string>

@@ -1,5 +1,5 @@
 // protocol.hpp: the line protocol of a grading binary's "clothlab" reporter, which writes one
-// event a line to a pipe of its own (tests/grade/grade_main.cpp describes the events).
+// event a line to a pipe of its own (tests/grade/harness/grade_main.cpp describes the events).
 #pragma once
 
 #include <string>

@@ -2,20 +2,30 @@
 
 #include <algorithm>
 #include <atomic>
+#include <stdexcept>
 #include <utility>
+
+#include <fmt/format.h>
 
 #include "clothlab/core/world.hpp"
 
 namespace clothlab {
 
-void SpringSet::add(Index a, Index b, double ks_ab, double kd_ab, double l0_ab, const Matrix3X& x) {
+void SpringSet::add(Index a, Index b, double ks_ab, double kd_ab, double l0_ab) {
+  if (!(l0_ab >= 0.0))
+    throw std::invalid_argument(fmt::format(
+        "a spring from particle {} to {} with rest length {} m; expected l0 >= 0", a, b, l0_ab));
   i_.push_back(a);
   j_.push_back(b);
   ks_.push_back(ks_ab);
   kd_.push_back(kd_ab);
-  l0_.push_back(l0_ab >= 0.0 ? l0_ab : (x.col(b) - x.col(a)).norm());
-  l_built_.push_back(l0_.back());
+  l0_.push_back(l0_ab);
+  l_built_.push_back(l0_ab);
   changed();
+}
+
+void SpringSet::add_at_rest(Index a, Index b, double ks_ab, double kd_ab, const Matrix3X& x) {
+  add(a, b, ks_ab, kd_ab, (x.col(b) - x.col(a)).norm());
 }
 
 void SpringSet::erase(const std::vector<size_t>& positions) {
@@ -82,7 +92,7 @@ void add_spring_family(SpringSet& springs, const std::vector<std::pair<Index, In
     return std::pair(p.second - p.first, p.first) < std::pair(q.second - q.first, q.first);
   });
   for (const auto& [a, b] : sorted)
-    springs.add(first + a, first + b, ks, kd, -1.0, x);
+    springs.add_at_rest(first + a, first + b, ks, kd, x);
 }
 
 const SpringDampers* find_spring_effect(const World& world, std::string_view name) {

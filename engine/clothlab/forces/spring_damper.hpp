@@ -76,8 +76,11 @@ class SpringSet {
   const std::vector<double>& l0() const { return l0_; }
   const std::vector<double>& l_built() const { return l_built_; }
 
-  // Adds a spring from a to b; l0 < 0 means "the distance between them in x".
-  void add(Index a, Index b, double ks_ab, double kd_ab, double l0_ab, const Matrix3X& x);
+  // Adds a spring from a to b with rest length l0_ab >= 0 [m] (a negative or NaN one throws
+  // std::invalid_argument).
+  void add(Index a, Index b, double ks_ab, double kd_ab, double l0_ab);
+  // Adds a spring from a to b at rest as the particles stand: l0 = |x_b - x_a| [m].
+  void add_at_rest(Index a, Index b, double ks_ab, double kd_ab, const Matrix3X& x);
   // Removes the springs at the given positions (ascending), keeping the others in order.
   void erase(const std::vector<size_t>& positions);
   // Spring k now joins a and b (its constants and lengths stay).

@@ -6,11 +6,10 @@ namespace clothlab {
 
 namespace {
 
-// Every particle moved by its own force with the one-particle kernel. `flatten` asks for the
-// kernel inlined at link time whatever else the program contains: GCC otherwise weighs it
-// against the kernel's other callers, and a call per particle makes the step much slower.
+// Every particle moved by its own force with the one-particle kernel (step 3): each particle's
+// new state depends on its own state and force alone.
 template <class Kernel>
-[[gnu::flatten]] void move_particles(Particles& p, double dt, Kernel kernel) {
+void move_particles(Particles& p, double dt, Kernel kernel) {
   for (Index i = 0; i < p.size(); ++i) {
     const PointState next = kernel(p.x.col(i), p.v.col(i), p.f.col(i), p.inv_m[i], dt);
     p.x.col(i) = next.r;
@@ -29,8 +28,7 @@ void euler_advance(World& world, double dt, Kernel kernel) {
 
 }  // namespace
 
-// The kernels are passed wrapped in lambdas, not as function pointers: a lambda is a type of its
-// own, so each loop is compiled for its kernel and the kernel inlined into it at link time.
+// The two methods differ only in the kernel that moves one particle (lesson 01's exercises).
 void ExplicitEuler::advance(World& world, double dt) {
   euler_advance(world, dt, [](const Vec3& r, const Vec3& v, const Vec3& f, double inv_m, double h) {
     return explicit_euler_step(r, v, f, inv_m, h);

@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # check_planted.sh CLOTHLAB SOURCE WORK_DIR PLANTS: grades submissions made from copies of
 # solutions/ with planted mistakes, and checks that each scores what PLANTS says it must. PLANTS
-# (tests/grade/planted/*.txt) holds blocks of two kinds:
+# (tests/grade/harness/planted/*.txt) holds blocks of two kinds:
 #
 #   mutant exNN.k FILE: what the mistake is
 #   - one line of solutions/FILE, as it is (leading spaces aside; it must occur exactly once)
@@ -23,14 +23,8 @@
 # cases included: it must compile and score 0 overall (a kernel that computes nothing earns
 # nothing).
 set -euo pipefail
-clothlab=$1
-source_dir=$2
-work=$3
+source "$(dirname "$0")/submission_checks.sh"
 plants=$4
-rm -rf "$work"
-mkdir -p "$work"
-problems=()
-problem() { problems+=("$*"); }
 
 # The results' total score, their maximum, and the cases that scored, from results.json (read
 # with CMake's JSON parser, which the build has anyway).

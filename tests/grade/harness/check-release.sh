@@ -17,7 +17,7 @@ if [[ $# -lt 1 ]]; then
   echo "usage: $0 [--gradescope] BUILD_DIR [WORK_DIR]" >&2
   exit 2
 fi
-source_dir=$(cd "$(dirname "$0")/../.." && pwd)
+source_dir=$(cd "$(dirname "$0")/../../.." && pwd)
 build=$(cd "$1" && pwd)
 work=${2:-$build/release-check}
 jobs=$(nproc)
@@ -36,8 +36,8 @@ cp -r "$build/student-release" "$release"
 
 [[ ! -e $release/solutions ]] || die "the release has solutions/"
 [[ ! -e $release/tests/grade-hidden ]] || die "the release has the hidden tests"
-[[ ! -e $release/tests/grade/planted ]] ||
-  die "the release has tests/grade/planted/, which quotes lines of the solutions"
+[[ ! -e $release/tests/grade/harness/planted ]] ||
+  die "the release has tests/grade/harness/planted/, which quotes lines of the solutions"
 [[ ! -e $release/.ci ]] || die "the release has our CI"
 for exercise in "$release"/exercises/[0-9][0-9]_*.cpp; do
   grep -q CLOTHLAB_TODO "$exercise" || die "$exercise is not a stub"

@@ -32,7 +32,7 @@ foreach(file CMakeLists.txt CMakePresets.json README.md course.toml .clang-forma
     file(COPY ${SOURCE}/${file} DESTINATION ${tree})
   endif()
 endforeach()
-# tests/grade/planted/ holds lines of the solutions (the mistakes are planted in copies of them),
+# tests/grade/harness/planted/ holds lines of the solutions (the mistakes are planted in copies of them),
 # and its tests run only where solutions/ is.
 foreach(dir engine lessons tests)
   file(COPY ${SOURCE}/${dir} DESTINATION ${tree}

@@ -1,5 +1,5 @@
 # submission_checks.sh: what the grader's submission checks share (check_hostile.sh,
-# check_confinement.sh, check_wire.sh), sourced after their `set -euo pipefail`. Takes the
+# check_confinement.sh, check_wire.sh, check_planted.sh), sourced after their `set -euo pipefail`. Takes the
 # scripts' arguments CLOTHLAB SOURCE WORK_DIR into $clothlab, $source_dir and $work (a work folder
 # made anew), and gives them problem MESSAGE, which collects a failure to report at the end, and
 # score_of RESULTS_JSON, the score in a results.json, read by CMake's JSON parser (which also
