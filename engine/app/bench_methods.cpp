@@ -20,11 +20,15 @@
 // a symplectic Euler step and an XPBD iteration cost per spring, each on the readable path (no
 // backend) and in the engine room (engine/fast/), measured in the same run, and the issue's
 // targets beside the ratios.
+//
+// Implicit Euler's rows: ns per spring per conjugate-gradient iteration, readable and engine
+// room, with the iterations per step, and a streaming pass over as many bytes as the bound.
 #include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <filesystem>
 #include <limits>
+#include <memory>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -35,6 +39,7 @@
 #include "analysis/stability.hpp"
 #include "app/bench.hpp"
 #include "clothlab/core/guard.hpp"
+#include "clothlab/core/threads.hpp"
 #include "clothlab/forces/spring_damper.hpp"
 #include "clothlab/integrators/implicit_euler.hpp"
 #include "clothlab/integrators/integrator.hpp"
@@ -372,6 +377,26 @@ CgTiming time_cg(const std::string& text, int steps, int repeats, int threads, b
   return best;
 }
 
+// The bound on a memory-bound pass: ns per spring of a streaming pass (y = y + s x, over
+// arrays as large as the bytes a conjugate-gradient iteration of the engine room moves, about
+// 240 per spring: engine/fast/implicit.cpp's four passes) on `threads` threads, fastest of 5.
+double streaming_ns_per_spring(size_t springs, int threads) {
+  const size_t n = springs * 240 / 24;  // y read and written, x read: 24 bytes an element
+  std::vector<double> x(n, 1.0), y(n, 0.0);
+  std::unique_ptr<ThreadTeam> team;
+  if (threads > 1) team = std::make_unique<ThreadTeam>(threads);
+  double best = std::numeric_limits<double>::infinity();
+  for (int r = 0; r < 5; ++r) {
+    const Clock::time_point start = Clock::now();
+    for_ranges(team.get(), static_cast<Index>(n), [&](Index begin, Index end) {
+      for (Index i = begin; i < end; ++i)
+        y[static_cast<size_t>(i)] += 1e-3 * x[static_cast<size_t>(i)];
+    });
+    best = std::min(best, std::chrono::duration<double>(Clock::now() - start).count());
+  }
+  return 1e9 * best / static_cast<double>(springs) + 0.0 * y[n / 2];
+}
+
 // One grid's figures on one number of threads [ns per spring].
 struct SpeedRow {
   int grid = 0, threads = 0;
@@ -480,6 +505,14 @@ void speed(const MethodsOptions& opt, const fs::path& out_dir) {
                  one.grid == 128 ? (cg >= 1.7 ? " (met)" : " (missed)") : "");
     }
     fmt::print("\n");
+    // What bounds it: the same bytes streamed once, on 1 and 2 threads.
+    const double stream1 = streaming_ns_per_spring(one.springs, 1),
+                 stream2 = streaming_ns_per_spring(one.springs, 2);
+    fmt::print(
+        "    bound: streaming the ~240 bytes per spring a CG iteration moves takes {:.2f} ns per "
+        "spring on 1 thread, {:.2f} on 2 ({:.2f} times faster); the CG iteration is {:.1f} "
+        "times the 1-thread stream\n",
+        stream1, stream2, stream1 / stream2, one.cg_iteration[1] / stream1);
   }
 
   std::string table = "grid,springs,measure,ns_per_spring,threads\n";
