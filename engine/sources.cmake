@@ -49,7 +49,8 @@ set(CLOTHLAB_FAST_SOURCES
   fast/forces.cpp
   fast/springs.cpp
   fast/aerodynamics.cpp
-  fast/xpbd.cpp)
+  fast/xpbd.cpp
+  fast/implicit.cpp)
 # What only the native program needs: runs, their files and the viewer page.
 set(CLOTHLAB_IO_SOURCES
   io/run.cpp

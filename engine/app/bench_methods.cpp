@@ -20,11 +20,15 @@
 // a symplectic Euler step and an XPBD iteration cost per spring, each on the readable path (no
 // backend) and in the engine room (engine/fast/), measured in the same run, and the issue's
 // targets beside the ratios.
+//
+// Implicit Euler's rows: ns per spring per conjugate-gradient iteration, readable and engine
+// room, with the iterations per step, and a streaming pass over as many bytes as the bound.
 #include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <filesystem>
 #include <limits>
+#include <memory>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -35,7 +39,9 @@
 #include "analysis/stability.hpp"
 #include "app/bench.hpp"
 #include "clothlab/core/guard.hpp"
+#include "clothlab/core/threads.hpp"
 #include "clothlab/forces/spring_damper.hpp"
+#include "clothlab/integrators/implicit_euler.hpp"
 #include "clothlab/integrators/integrator.hpp"
 #include "io/files.hpp"
 #include "scene/scene.hpp"
@@ -380,11 +386,61 @@ double time_steps(const std::string& text, int steps, int repeats, int threads, 
   return best;
 }
 
+// Implicit Euler's conjugate gradients: the fastest of `repeats` runs of `steps` steps of dt [s]
+// (a large step, so that each solve takes enough iterations to time), as [s] in the solves per
+// iteration, and the iterations per step.
+struct CgTiming {
+  double seconds_per_iteration = std::numeric_limits<double>::infinity();
+  double iterations_per_step = 0.0;
+};
+
+CgTiming time_cg(const std::string& text, int steps, int repeats, int threads, bool fast,
+                 double dt) {
+  CgTiming best;
+  for (int r = 0; r < repeats; ++r) {
+    World world = std::move(parse_scene(text, "<speed>").world);
+    if (!fast) world.backend.reset();
+    world.threads = threads;
+    for (int s = 0; s < steps; ++s)
+      world.step(dt);
+    const auto& implicit = dynamic_cast<const ImplicitEuler&>(*world.integrator);
+    const LinearSolveStats& stats = implicit.stats();
+    if (stats.iterations == 0) continue;
+    best.seconds_per_iteration = std::min(
+        best.seconds_per_iteration, stats.solve_seconds / static_cast<double>(stats.iterations));
+    best.iterations_per_step = static_cast<double>(stats.iterations) / steps;
+  }
+  return best;
+}
+
+// The bound on a memory-bound pass: ns per spring of a streaming pass (y = y + s x, over
+// arrays as large as the bytes a conjugate-gradient iteration of the engine room moves, about
+// 240 per spring: engine/fast/implicit.cpp's four passes) on `threads` threads, fastest of 5.
+double streaming_ns_per_spring(size_t springs, int threads) {
+  const size_t n = springs * 240 / 24;  // y read and written, x read: 24 bytes an element
+  std::vector<double> x(n, 1.0), y(n, 0.0);
+  std::unique_ptr<ThreadTeam> team;
+  if (threads > 1) team = std::make_unique<ThreadTeam>(threads);
+  double best = std::numeric_limits<double>::infinity();
+  for (int r = 0; r < 5; ++r) {
+    const Clock::time_point start = Clock::now();
+    for_ranges(team.get(), static_cast<Index>(n), [&](Index begin, Index end) {
+      for (Index i = begin; i < end; ++i)
+        y[static_cast<size_t>(i)] += 1e-3 * x[static_cast<size_t>(i)];
+    });
+    best = std::min(best, std::chrono::duration<double>(Clock::now() - start).count());
+  }
+  return 1e9 * best / static_cast<double>(springs) + 0.0 * y[n / 2];
+}
+
 // One grid's figures on one number of threads [ns per spring].
 struct SpeedRow {
   int grid = 0, threads = 0;
   size_t springs = 0;
   double euler[2] = {}, xpbd_one[2] = {}, xpbd_iteration[2] = {};  // [readable, engine room]
+
+  // Implicit Euler: ns per spring per conjugate-gradient iteration, and iterations per step.
+  double cg_iteration[2] = {}, cg_iterations[2] = {};
 };
 
 SpeedRow measure_speed(int grid, int threads, bool quick) {
@@ -407,6 +463,12 @@ SpeedRow measure_speed(int grid, int threads, bool quick) {
     row.xpbd_one[fast] = time(speed_scene(grid, "xpbd", 1, 1));
     const double many = time(speed_scene(grid, "xpbd", 1, 1 + kMore));
     row.xpbd_iteration[fast] = (many - row.xpbd_one[fast]) / kMore;
+
+    // Implicit Euler at 1/600 s, a tenth of a frame: the solves time its iterations.
+    const CgTiming cg = time_cg(speed_scene(grid, "implicit-euler", 0, 0), quick ? 2 : 6,
+                                quick ? 1 : 3, threads, fast == 1, 1.0 / 600);
+    row.cg_iteration[fast] = 1e9 * cg.seconds_per_iteration / static_cast<double>(row.springs);
+    row.cg_iterations[fast] = cg.iterations_per_step;
   }
   return row;
 }
@@ -453,6 +515,42 @@ void speed(const MethodsOptions& opt, const fs::path& out_dir) {
     }
     fmt::print("\n");
   }
+
+  // Implicit Euler's conjugate-gradient iterations, and the targets for them.
+  fmt::print(
+      "\n  implicit Euler at dt = 1/600 s: ns per spring per conjugate-gradient iteration "
+      "(the time in the solves over their iterations), iterations per step\n");
+  fmt::print("  {:>9} {:>7} | {:>21} | {:>21} | {:>16}\n", "grid", "threads", "CG iteration",
+             "CG iterations/step", "CG it./Euler step");
+  fmt::print("  {:>9} {:>7} | {:>10} {:>10} | {:>10} {:>10} | {:>16}\n", "", "", "readable",
+             "engine", "readable", "engine", "engine (<=2)");
+  for (const SpeedRow& r : rows) {
+    fmt::print("  {:>9} {:>7} | {:10.2f} {:10.2f} | {:10.1f} {:10.1f} | {:16.2f}\n",
+               fmt::format("{0} x {0}", r.grid), r.threads, r.cg_iteration[0], r.cg_iteration[1],
+               r.cg_iterations[0], r.cg_iterations[1], r.cg_iteration[1] / r.euler[1]);
+  }
+  for (const SpeedRow& one : rows) {
+    if (one.threads != 1) continue;
+    const double ratio = one.cg_iteration[1] / one.euler[1];
+    fmt::print("  {0} x {0}: CG iteration / Euler step = {1:.2f} ({2})", one.grid, ratio,
+               ratio <= 2.0 ? "met" : "missed");
+    for (const SpeedRow& two : rows) {
+      if (two.grid != one.grid || two.threads != 2) continue;
+      const double cg = one.cg_iteration[1] / two.cg_iteration[1];
+      fmt::print("; 2 threads over 1: CG {:.2f}{}", cg,
+                 one.grid == 128 ? (cg >= 1.7 ? " (met)" : " (missed)") : "");
+    }
+    fmt::print("\n");
+    // What bounds it: the same bytes streamed once, on 1 and 2 threads.
+    const double stream1 = streaming_ns_per_spring(one.springs, 1),
+                 stream2 = streaming_ns_per_spring(one.springs, 2);
+    fmt::print(
+        "    bound: streaming the ~240 bytes per spring a CG iteration moves takes {:.2f} ns per "
+        "spring on 1 thread, {:.2f} on 2 ({:.2f} times faster); the CG iteration is {:.1f} "
+        "times the 1-thread stream\n",
+        stream1, stream2, stream1 / stream2, one.cg_iteration[1] / stream1);
+  }
+
   std::string table = "grid,springs,measure,ns_per_spring,threads\n";
   for (const SpeedRow& r : rows) {
     for (int fast = 0; fast < 2; ++fast) {
@@ -464,6 +562,8 @@ void speed(const MethodsOptions& opt, const fs::path& out_dir) {
       add("symplectic-euler-step", r.euler[fast]);
       add("xpbd-substep-1-iteration", r.xpbd_one[fast]);
       add("xpbd-iteration", r.xpbd_iteration[fast]);
+
+      add("implicit-euler-cg-iteration", r.cg_iteration[fast]);
     }
   }
   write_whole_file(out_dir / "speed.csv", table);

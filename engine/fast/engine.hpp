@@ -31,6 +31,9 @@
 // Of an XPBD step it takes the projections only (xpbd_project, in xpbd.cpp): colour by colour
 // of the integrator's constraint colouring, each colour split over the threads, with the bits
 // of the integrator's own loop.
+//
+// Of an implicit Euler step it takes the whole (implicit_euler_step, in implicit.cpp): the
+// Jacobians spring by spring and a matrix-free conjugate-gradient solve on the threads.
 #pragma once
 
 #include <functional>
@@ -62,6 +65,8 @@ inline constexpr Index kPassChunk = 512;
 // per block (32 for a 256-wide cloth). SPEED.md has the measurements behind the size.
 inline constexpr Index kPassBlock = 8192;
 
+struct ImplicitSolver;
+
 class FastEngine final : public Backend {
  public:
   // Particles a thread sums and moves at once in a step's one pass (kPassBlock). Any value
@@ -73,11 +78,19 @@ class FastEngine final : public Backend {
   // value gives the same bits.
   Index xpbd_split = 2048;
 
+  // Implicit Euler's conjugate gradients (implicit.cpp), preconditioned by the inverse of each
+  // particle's 3x3 diagonal block of the matrix (block Jacobi), or of its diagonal alone (as
+  // the lecture's solver is). SPEED.md measures what the blocks save.
+  enum class Preconditioner { diagonal, block_jacobi };
+  Preconditioner implicit_preconditioner = Preconditioner::block_jacobi;
+
   bool sum_forces(const World& world, const Matrix3X& x, const Matrix3X& v, Matrix3X& f) override;
   BackendStep step(World& world, double dt) override;
   bool xpbd_project(World& world, const XpbdConstraints& constraints, const Matrix3X& x_old,
                     double h, int iterations, bool keep_lambda,
                     std::vector<double>& lambda) override;
+  bool implicit_euler_step(World& world, double dt, double tolerance, int max_iterations,
+                           VectorX& dv, LinearSolveStats& stats) override;
 
   // Which of the world's force effects it summed itself in its last evaluation ("gravity+
   // springs+ buoyancy-"), for tests and for `clothlab bench`.
@@ -124,6 +137,7 @@ class FastEngine final : public Backend {
   std::vector<Contact> contacts_;
   Copies copies_;
   SoA3 xpbd_x_, xpbd_old_;  // x and x_old in the fast layout, for XPBD's projections
+  std::shared_ptr<ImplicitSolver> implicit_;  // implicit Euler's arrays (implicit.cpp)
 };
 
 // A world's fast engine: what a scene installs as World::backend.

@@ -19,6 +19,7 @@ namespace clothlab {
 
 class World;
 struct XpbdConstraints;
+struct LinearSolveStats;
 
 // What a backend took of a step (Backend::step).
 struct BackendStep {
@@ -51,6 +52,19 @@ class Backend {
   virtual bool xpbd_project(World& /*world*/, const XpbdConstraints& /*constraints*/,
                             const Matrix3X& /*x_old*/, double /*h*/, int /*iterations*/,
                             bool /*keep_lambda*/, std::vector<double>& /*lambda*/) {
+    return false;
+  }
+
+  // One step of dt [s] of implicit Euler (integrators/implicit_euler.hpp) whole: f0, the
+  // Jacobians, the conjugate-gradient solve of (M - dt D - dt^2 K) dv = dt (f0 + dt K v) to a
+  // relative residual `tolerance` in at most `max_iterations` iterations, starting from dv (3 per
+  // particle, the previous step's solution, or empty), then v += dv, x += dt v. dv is left
+  // holding this step's solution, and the solve is counted in `stats`. Not the same bits as
+  // ImplicitEuler::advance's own solve (another order of the same sums): the same solution to
+  // within the tolerance. False: declined, nothing changed.
+  virtual bool implicit_euler_step(World& /*world*/, double /*dt*/, double /*tolerance*/,
+                                   int /*max_iterations*/, VectorX& /*dv*/,
+                                   LinearSolveStats& /*stats*/) {
     return false;
   }
 };

@@ -55,6 +55,9 @@ class ImplicitEuler final : public Integrator {
   int max_iterations = 500;  // iterations after which a solve stops anyway
 
   const LinearSolveStats& stats() const { return stats_; }
+  // How many steps the world's backend took whole (Backend::implicit_euler_step); the others
+  // ran the code below.
+  long backend_steps = 0;
 
   // One 3x3 block of A = M - dt D - dt^2 K at block row i, block column j.
   struct Block {
