@@ -36,7 +36,7 @@
 #include "app/bench.hpp"
 #include "clothlab/core/guard.hpp"
 #include "clothlab/forces/spring_damper.hpp"
-#include "clothlab/integrators/integrator.hpp"
+#include "clothlab/integrators/methods.hpp"
 #include "io/files.hpp"
 #include "scene/scene.hpp"
 

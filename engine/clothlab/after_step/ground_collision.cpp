@@ -53,7 +53,7 @@ void StepStart::record(const World& world) {
   v_ = world.particles.v;
 }
 
-void Ground::apply(World& world, double /*dt*/) {
+void Ground::apply(World& world, const StepTime& /*time*/) {
   collide(world.particles, 0, world.particles.size());
 }
 
@@ -90,7 +90,7 @@ void Ground::apply(World& world, double /*dt*/) {
   }
 }
 
-void Sphere::apply(World& world, double /*dt*/) {
+void Sphere::apply(World& world, const StepTime& /*time*/) {
   collide(world.particles, 0, world.particles.size());
 }
 
@@ -119,7 +119,7 @@ void Sphere::apply(World& world, double /*dt*/) {
   }
 }
 
-void Plane::apply(World& world, double /*dt*/) {
+void Plane::apply(World& world, const StepTime& /*time*/) {
   collide(world.particles, 0, world.particles.size());
 }
 
