@@ -7,6 +7,7 @@
 set(CLOTHLAB_PHYSICS_SOURCES
   clothlab/core/particles.cpp
   clothlab/core/world.cpp
+  clothlab/core/step_timer.cpp
   clothlab/core/guard.cpp
   clothlab/core/threads.cpp
   clothlab/forces/gravity.cpp
@@ -15,7 +16,7 @@ set(CLOTHLAB_PHYSICS_SOURCES
   clothlab/forces/bending.cpp
   clothlab/forces/damping.cpp
   clothlab/forces/aerodynamics.cpp
-  clothlab/integrators/integrator.cpp
+  clothlab/integrators/methods.cpp
   clothlab/integrators/euler.cpp
   clothlab/integrators/runge_kutta.cpp
   clothlab/integrators/verlet.cpp

@@ -13,6 +13,7 @@
 #include "analysis/stability.hpp"
 #include "clothlab/forces/spring_damper.hpp"
 #include "clothlab/integrators/implicit_euler.hpp"
+#include "clothlab/integrators/methods.hpp"
 #include "scene/scene.hpp"
 
 namespace clothlab {

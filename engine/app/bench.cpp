@@ -33,7 +33,7 @@
 #include "clothlab/core/world.hpp"
 #include "clothlab/forces/gravity.hpp"
 #include "clothlab/integrators/euler.hpp"
-#include "clothlab/integrators/integrator.hpp"
+#include "clothlab/integrators/methods.hpp"
 #include "io/files.hpp"
 #include "scene/scene.hpp"
 

@@ -42,7 +42,7 @@
 #include "clothlab/core/threads.hpp"
 #include "clothlab/forces/spring_damper.hpp"
 #include "clothlab/integrators/implicit_euler.hpp"
-#include "clothlab/integrators/integrator.hpp"
+#include "clothlab/integrators/methods.hpp"
 #include "io/files.hpp"
 #include "scene/scene.hpp"
 

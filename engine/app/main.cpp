@@ -161,8 +161,8 @@ int run(Scene& scene, const RunOutputs& outputs, bool stats) {
   // The folder as a user reads it: "out/" and "./out" are "out".
   fs::path out_dir = outputs.dir.lexically_normal();
   if (!out_dir.has_filename() && out_dir.has_parent_path()) out_dir = out_dir.parent_path();
-  StepTimes times;
-  if (stats) scene.world.timing = &times;
+  StepTimer timer;
+  if (stats) timer.attach(scene.world);
   fmt::print("clothlab ({} build): {}{}\n", app::kKernels, shown(scene.source),
              scene.title.empty() ? "" : " - " + shown(scene.title));
   fmt::print("  {}; {}; dt = {} s for {} s ({} steps)\n", particle_count(scene),
@@ -220,7 +220,7 @@ int run(Scene& scene, const RunOutputs& outputs, bool stats) {
                    outputs.npy || scene.output.npy ? "data" : "CSV");
       }
     }
-    if (stats) print_stats(scene.world, times);
+    if (stats) print_stats(scene.world, timer.times);
     warn_unconverged(scene.world);
     return 0;
   } catch (const SimulationError& error) {

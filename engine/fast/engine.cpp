@@ -156,7 +156,7 @@ BackendStep FastEngine::step(World& world, double dt) {
   checks.end = contacts_.size() == world.post_step_effects.size();
   pass(world, p.x, p.v, p.f, moves, &checks);
   ++world.force_evaluations;
-  ++world.fast_evaluations;
+  ++world.backend_evaluations;
   return {true, contacts_.size(), checks.end_checked && checks.end_within};
 }
 

@@ -23,6 +23,7 @@
 #include "clothlab/forces/gravity.hpp"
 #include "clothlab/integrators/implicit_euler.hpp"
 #include "clothlab/integrators/local_global.hpp"
+#include "clothlab/integrators/methods.hpp"
 #include "clothlab/integrators/xpbd.hpp"
 
 namespace clothlab {

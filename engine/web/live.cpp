@@ -31,7 +31,7 @@
 #include "clothlab/core/guard.hpp"
 #include "clothlab/core/not_implemented.hpp"
 #include "clothlab/forces/spring_damper.hpp"
-#include "clothlab/integrators/integrator.hpp"
+#include "clothlab/integrators/methods.hpp"
 #include "scene/scene.hpp"
 #include "scene/simulation.hpp"
 

@@ -23,6 +23,7 @@
 #include "clothlab/forces/gravitation.hpp"
 #include "clothlab/forces/gravity.hpp"
 #include "clothlab/integrators/euler.hpp"
+#include "clothlab/integrators/methods.hpp"
 
 using namespace clothlab;
 using namespace clothlab::lesson;

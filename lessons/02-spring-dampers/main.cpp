@@ -24,6 +24,7 @@
 #include "clothlab/core/world.hpp"
 #include "clothlab/forces/gravity.hpp"
 #include "clothlab/forces/spring_damper.hpp"
+#include "clothlab/integrators/methods.hpp"
 
 using namespace clothlab;
 using namespace clothlab::lesson;

@@ -22,6 +22,7 @@
 #include "clothlab/forces/aerodynamics.hpp"
 #include "clothlab/forces/gravity.hpp"
 #include "clothlab/forces/spring_damper.hpp"
+#include "clothlab/integrators/methods.hpp"
 
 using namespace clothlab;
 using namespace clothlab::lesson;

@@ -16,6 +16,7 @@
 #include "clothlab/core/not_implemented.hpp"
 #include "clothlab/core/world.hpp"
 #include "clothlab/forces/gravity.hpp"
+#include "clothlab/integrators/methods.hpp"
 
 using namespace clothlab;
 using namespace clothlab::lesson;

@@ -28,6 +28,7 @@
 #include "clothlab/core/not_implemented.hpp"
 #include "clothlab/forces/spring_damper.hpp"
 #include "clothlab/integrators/implicit_euler.hpp"
+#include "clothlab/integrators/methods.hpp"
 #include "scene/scene.hpp"
 
 using namespace clothlab;

@@ -20,6 +20,7 @@
 #include "clothlab/bodies/cloth.hpp"
 #include "clothlab/core/guard.hpp"
 #include "clothlab/forces/gravity.hpp"
+#include "clothlab/integrators/methods.hpp"
 #include "clothlab/integrators/xpbd.hpp"
 #include "scene/scene.hpp"
 

@@ -25,6 +25,7 @@
 #include "clothlab/core/guard.hpp"
 #include "clothlab/forces/gravity.hpp"
 #include "clothlab/integrators/local_global.hpp"
+#include "clothlab/integrators/methods.hpp"
 #include "clothlab/integrators/xpbd.hpp"
 #include "scene/scene.hpp"
 

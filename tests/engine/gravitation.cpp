@@ -5,6 +5,7 @@
 
 #include "clothlab/core/world.hpp"
 #include "clothlab/forces/gravitation.hpp"
+#include "clothlab/integrators/methods.hpp"
 
 using clothlab::Vec3;
 

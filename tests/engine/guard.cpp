@@ -7,7 +7,7 @@
 #include <fmt/format.h>
 
 #include "clothlab/forces/gravity.hpp"
-#include "clothlab/integrators/integrator.hpp"
+#include "clothlab/integrators/methods.hpp"
 #include "scene/scene.hpp"
 #include "test_util.hpp"
 
@@ -246,7 +246,7 @@ TEST_CASE("guard: a blow-up stops the fast path's one pass as it stops the reada
         clothlab::Scene fast = hanging_cloth(method, 4e5, 0.002, extra);
         fast.world.threads = threads;
         const Stop stop = run_until_stopped(fast, 2000);
-        CHECK(fast.world.fast_evaluations > 0);
+        CHECK(fast.world.backend_evaluations > 0);
         CHECK(stop.step == expected.step);
         CHECK(stop.particle == expected.particle);
         CHECK(stop.what == expected.what);

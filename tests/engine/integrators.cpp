@@ -23,6 +23,7 @@
 #include "clothlab/forces/gravity.hpp"
 #include "clothlab/forces/spring_damper.hpp"
 #include "clothlab/integrators/implicit_euler.hpp"
+#include "clothlab/integrators/methods.hpp"
 #include "scene/scene.hpp"
 #include "test_util.hpp"
 

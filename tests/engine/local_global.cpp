@@ -14,6 +14,7 @@
 #include "clothlab/core/guard.hpp"
 #include "clothlab/forces/gravity.hpp"
 #include "clothlab/integrators/local_global.hpp"
+#include "clothlab/integrators/methods.hpp"
 #include "scene/scene.hpp"
 #include "test_util.hpp"
 

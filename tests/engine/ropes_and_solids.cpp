@@ -95,7 +95,7 @@ TEST_CASE("strain limiting: enough sweeps bring every spring of a stretched clot
   const Vec3 pinned = w.particles.x.col(0);
   clothlab::StrainLimiting* limiter = limiter_of(w);
   REQUIRE(limiter != nullptr);
-  limiter->apply(w, scene.dt);
+  limiter->apply(w, clothlab::StepTime::whole(w.t, scene.dt));
   CAPTURE(limiter->last_sweeps());
   // Every spring at most 10 % long, up to the tolerance the sweeps stop at (1e-9 of l0; a few
   // times that after the last sweep's corrections).
@@ -115,7 +115,7 @@ TEST_CASE("strain limiting: a few sweeps reduce the total excess and stop at the
   clothlab::World& w = scene.world;
   stretch(w.particles);
   const double before = total_excess(w);
-  limiter_of(w)->apply(w, scene.dt);
+  limiter_of(w)->apply(w, clothlab::StepTime::whole(w.t, scene.dt));
   CHECK(limiter_of(w)->last_sweeps() == 3);
   CAPTURE(before);
   CHECK(total_excess(w) < 0.5 * before);
@@ -148,7 +148,7 @@ TEST_CASE("strain limiting: a correction between two free particles keeps moment
   const Vec3 momentum = w.momentum();
   const Vec3 centre = w.particles.x * w.particles.m / 4.0;
   const double dt = 0.01;  // [s]
-  limiter.apply(w, dt);
+  limiter.apply(w, clothlab::StepTime::whole(w.t, dt));
   const Vec3 dr0 = w.particles.x.col(0) - Vec3(0.0, 0.0, 0.0);
   CHECK((w.particles.x.col(1) - w.particles.x.col(0)).norm() == doctest::Approx(1.1));
   CHECK((w.momentum() - momentum).norm() <= 1e-12);
@@ -165,7 +165,7 @@ TEST_CASE("strain limiting: nothing moves when no spring is past its limit") {
   clothlab::World& w = scene.world;
   w.particles.v.setConstant(0.25);  // any velocity: the effect must not touch it either
   const clothlab::Matrix3X x = w.particles.x, v = w.particles.v;
-  limiter_of(w)->apply(w, scene.dt);
+  limiter_of(w)->apply(w, clothlab::StepTime::whole(w.t, scene.dt));
   CHECK(limiter_of(w)->last_sweeps() == 1);
   CHECK(w.particles.x == x);
   CHECK(w.particles.v == v);

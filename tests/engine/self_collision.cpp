@@ -232,7 +232,7 @@ duration = 1
   const Matrix3X before = f.particles.x;
   clothlab::SelfCollision* s = self_collision_of(f);
   REQUIRE(s != nullptr);
-  s->apply(f, fresh.dt);
+  s->apply(f, clothlab::StepTime::whole(f.t, fresh.dt));
   CHECK(s->last_pairs() == 2);
   // The pinned particles, bit for bit, position and velocity.
   CHECK(f.particles.x.col(0) == before.col(0));

@@ -33,6 +33,7 @@
 #include "clothlab/core/world.hpp"
 #include "clothlab/forces/spring_damper.hpp"
 #include "clothlab/integrators/implicit_euler.hpp"
+#include "clothlab/integrators/methods.hpp"
 #include "test_util.hpp"
 
 using clothlab::Vec3;

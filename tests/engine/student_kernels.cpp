@@ -70,7 +70,7 @@ duration = 1
   REQUIRE(effect != nullptr);
   // The effect's own step, as World::step calls it after the integrator (whose kernels are
   // stubs too, so the step itself would stop at lesson 01).
-  CHECK(stops_at([&] { effect->apply(w, scene.dt); }) == "ex10.1");
+  CHECK(stops_at([&] { effect->apply(w, clothlab::StepTime::whole(w.t, scene.dt)); }) == "ex10.1");
   CHECK(stops_at([&] { effect->detect(w.particles.x, 1e6); }) == "ex10.1");
   // The response, given the pair that detection finds once ex10.1 is done: the two particles
   // brought within the thickness (0.01 m apart, thickness 0.05 m) go through the student's

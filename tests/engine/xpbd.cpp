@@ -12,6 +12,7 @@
 
 #include "clothlab/after_step/ground_collision.hpp"
 #include "clothlab/core/guard.hpp"
+#include "clothlab/integrators/methods.hpp"
 #include "clothlab/integrators/xpbd.hpp"
 #include "scene/scene.hpp"
 #include "test_util.hpp"

@@ -213,7 +213,7 @@ TEST_CASE("fast path: ks and kd changed in place between steps reach the forces"
     }
     const clothlab::World& readable = scenes[0].world;
     const clothlab::World& fast = scenes[1].world;
-    CHECK(fast.fast_evaluations == fast.force_evaluations);
+    CHECK(fast.backend_evaluations == fast.force_evaluations);
     CHECK(identical(fast.particles.x, readable.particles.x));
     CHECK(identical(fast.particles.v, readable.particles.v));
     // The edits changed the motion: without them the state differs.
@@ -265,7 +265,7 @@ TEST_CASE("fast path: springs edited between steps give the readable path's stat
       }
       const clothlab::World& readable = scenes[0].world;
       const clothlab::World& fast = scenes[1].world;
-      CHECK(fast.fast_evaluations > 0);
+      CHECK(fast.backend_evaluations > 0);
       CHECK(identical(fast.particles.x, readable.particles.x));
       CHECK(identical(fast.particles.v, readable.particles.v));
     }
@@ -301,9 +301,9 @@ TEST_CASE("fast path: the same state as the readable path, bit for bit, every in
     CHECK(identical(fast.world.particles.x, readable.world.particles.x));
     CHECK(identical(fast.world.particles.v, readable.world.particles.v));
     // The fast one did take the fast path, every evaluation; the readable one never did.
-    CHECK(fast.world.fast_evaluations == fast.world.force_evaluations);
-    CHECK(fast.world.fast_evaluations >= steps);
-    CHECK(readable.world.fast_evaluations == 0);
+    CHECK(fast.world.backend_evaluations == fast.world.force_evaluations);
+    CHECK(fast.world.backend_evaluations >= steps);
+    CHECK(readable.world.backend_evaluations == 0);
     // The cloth moved: the test compares something.
     CHECK((fast.world.particles.x - clothlab::parse_scene(text, "t").world.particles.x)
               .cwiseAbs()
@@ -352,7 +352,7 @@ TEST_CASE("fast path: effects without a fast path, between and after those with 
     // Which effects the fast engine summed itself, in the world's order.
     CHECK(engine_of(fast).plan() ==
           "springs+ pull- bending+ damping+ gravity+ aerodynamics+ drag+ buoyancy-");
-    CHECK(fast.fast_evaluations == fast.force_evaluations);
+    CHECK(fast.backend_evaluations == fast.force_evaluations);
     CHECK(identical(fast.particles.x, readable.particles.x));
     CHECK(identical(fast.particles.v, readable.particles.v));
     // Buoyancy acts: part of the cloth is below its surface.
@@ -401,7 +401,7 @@ TEST_CASE("fast path: the Euler methods move particles in the pass that sums the
       const clothlab::World& readable = readable_scene.world;
       const clothlab::World& fast = fast_scene.world;
       REQUIRE(engine_of(fast).plan().ends_with("drag+"));
-      CHECK(fast.fast_evaluations == fast.force_evaluations);
+      CHECK(fast.backend_evaluations == fast.force_evaluations);
       CHECK(identical(fast.particles.x, readable.particles.x));
       CHECK(identical(fast.particles.v, readable.particles.v));
       CHECK(identical(fast.particles.f, readable.particles.f));
@@ -431,7 +431,7 @@ TEST_CASE("fast path: blocks of any size give the readable state bit for bit") {
         engine_of(w).pass_block = block;
       });
       REQUIRE(engine_of(fast.world).plan().ends_with("drag+"));
-      CHECK(fast.world.fast_evaluations == fast.world.force_evaluations);
+      CHECK(fast.world.backend_evaluations == fast.world.force_evaluations);
       CHECK(identical(fast.world.particles.x, readable.world.particles.x));
       CHECK(identical(fast.world.particles.v, readable.world.particles.v));
       CHECK(identical(fast.world.particles.f, readable.world.particles.f));
@@ -468,8 +468,8 @@ period = 0.1
       scene_text.replace(scene_text.find("symplectic-euler"), 16, method);
       const clothlab::Scene readable = run(scene_text, false, threads, 100);
       const clothlab::Scene fast = run(scene_text, true, threads, 100);
-      CHECK(fast.world.fast_evaluations == fast.world.force_evaluations);
-      CHECK(fast.world.fast_evaluations >= 100);
+      CHECK(fast.world.backend_evaluations == fast.world.force_evaluations);
+      CHECK(fast.world.backend_evaluations >= 100);
       CHECK(identical(fast.world.particles.x, readable.world.particles.x));
       CHECK(identical(fast.world.particles.v, readable.world.particles.v));
       // The pins did move, and the wind did change.
@@ -508,7 +508,7 @@ TEST_CASE("fast path: runs just below, at and above the gap where forces skip th
       CAPTURE(cols);
       CAPTURE(threads);
       const clothlab::Scene fast = run(text, true, threads, 80);
-      CHECK(fast.world.fast_evaluations == fast.world.force_evaluations);
+      CHECK(fast.world.backend_evaluations == fast.world.force_evaluations);
       CHECK(identical(fast.world.particles.x, readable.world.particles.x));
       CHECK(identical(fast.world.particles.v, readable.world.particles.v));
     }
@@ -593,7 +593,7 @@ TEST_CASE("fast path: triangles in other orders give the readable result") {
           scene.world.step(scene.dt);
         scenes.push_back(std::move(scene));
       }
-      CHECK(scenes[1].world.fast_evaluations == scenes[1].world.force_evaluations);
+      CHECK(scenes[1].world.backend_evaluations == scenes[1].world.force_evaluations);
       CHECK(identical(scenes[1].world.particles.x, scenes[0].world.particles.x));
       CHECK(identical(scenes[1].world.particles.v, scenes[0].world.particles.v));
     }
@@ -649,7 +649,7 @@ TEST_CASE("fast path: springs listed from their higher-numbered end match the re
     fast.world.step(fast.dt);
     readable.world.step(readable.dt);
   }
-  CHECK(fast.world.fast_evaluations == 100);
+  CHECK(fast.world.backend_evaluations == 100);
   CHECK(identical(fast.world.particles.x, readable.world.particles.x));
   CHECK(identical(fast.world.particles.v, readable.world.particles.v));
 }
@@ -674,11 +674,11 @@ class PushLowParticles final : public clothlab::PostStepEffect {
  public:
   long wholes = 0;
   std::string_view name() const override { return "push"; }
-  void apply(clothlab::World& world, double dt) override {
+  void apply(clothlab::World& world, const clothlab::StepTime& time) override {
     ++wholes;
     clothlab::Particles& p = world.particles;
     for (Index i = 0; i < p.size(); ++i)
-      if (p.x(1, i) < -0.3 && p.inv_m[i] > 0.0) p.v(0, i) += 0.5 * dt;
+      if (p.x(1, i) < -0.3 && p.inv_m[i] > 0.0) p.v(0, i) += 0.5 * time.h;
   }
 };
 
@@ -687,7 +687,7 @@ class RecordLowest final : public clothlab::PostStepEffect {
  public:
   std::vector<double> lowest;
   std::string_view name() const override { return "record"; }
-  void apply(clothlab::World& world, double /*dt*/) override {
+  void apply(clothlab::World& world, const clothlab::StepTime& /*time*/) override {
     lowest.push_back(world.particles.x.row(1).minCoeff());
   }
 };
@@ -747,7 +747,7 @@ TEST_CASE(
     };
     const clothlab::Scene one_pass = run(text, true, threads, 40, push_first);
     CHECK(push->wholes == 40);
-    CHECK(one_pass.world.fast_evaluations == 40);
+    CHECK(one_pass.world.backend_evaluations == 40);
     const clothlab::Scene separate = run_in_separate_passes(text, 40, push_first);
     CHECK(push->wholes == 40);
     CHECK(identical(one_pass.world.particles.x, separate.world.particles.x));
@@ -759,8 +759,9 @@ TEST_CASE(
     CAPTURE(fast);
     clothlab::Scene scene = clothlab::parse_scene(text, "fast-path.toml");
     if (!fast) scene.world.backend.reset();
-    clothlab::StepTimes times;
-    scene.world.timing = &times;
+    clothlab::StepTimer timer;
+    timer.attach(scene.world);
+    const clothlab::StepTimes& times = timer.times;
     for (int step = 0; step < 20; ++step)
       scene.world.step(scene.dt);
     REQUIRE(scene.world.post_step_effects.front()->name() == "ground");

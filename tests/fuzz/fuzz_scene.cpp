@@ -11,7 +11,7 @@
 
 #include "clothlab/core/guard.hpp"
 #include "clothlab/integrators/implicit_euler.hpp"
-#include "clothlab/integrators/integrator.hpp"
+#include "clothlab/integrators/methods.hpp"
 #include "scene/scene.hpp"
 
 namespace {

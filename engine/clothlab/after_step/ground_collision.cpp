@@ -53,7 +53,7 @@ void StepStart::record(const World& world) {
   v_ = world.particles.v;
 }
 
-void Ground::apply(World& world, double /*dt*/) {
+void Ground::apply(World& world, const StepTime& /*time*/) {
   collide(world.particles, 0, world.particles.size());
 }
 
@@ -91,7 +91,7 @@ void Ground::collide(Particles& p, Index begin, Index end) const {
   }
 }
 
-void Sphere::apply(World& world, double /*dt*/) {
+void Sphere::apply(World& world, const StepTime& /*time*/) {
   collide(world.particles, 0, world.particles.size());
 }
 
@@ -120,7 +120,7 @@ void Sphere::collide(Particles& p, Index begin, Index end) const {
   }
 }
 
-void Plane::apply(World& world, double /*dt*/) {
+void Plane::apply(World& world, const StepTime& /*time*/) {
   collide(world.particles, 0, world.particles.size());
 }
 

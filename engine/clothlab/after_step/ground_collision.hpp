@@ -26,7 +26,6 @@
 #pragma once
 
 #include "clothlab/core/effect.hpp"
-#include "clothlab/integrators/euler.hpp"
 
 namespace clothlab {
 
@@ -70,7 +69,7 @@ class Ground final : public PostStepEffect {
   std::string_view name() const override { return "ground"; }
   void before_step(const World& world) override { start_.record(world); }
   bool each_substep() const override { return true; }
-  void apply(World& world, double dt) override;
+  void apply(World& world, const StepTime& time) override;
   // apply's loop on particles [begin, end) only: each particle is pushed out from its own state
   // alone, so ranges may be taken apart (and by different threads at once).
   void collide(Particles& p, Index begin, Index end) const;
@@ -94,7 +93,7 @@ class Plane final : public PostStepEffect {
   std::string_view name() const override { return "plane"; }
   void before_step(const World& world) override { start_.record(world); }
   bool each_substep() const override { return true; }
-  void apply(World& world, double dt) override;
+  void apply(World& world, const StepTime& time) override;
   void collide(Particles& p, Index begin, Index end) const;
   const Vec3& point() const { return point_; }
   const Vec3& normal() const { return normal_; }
@@ -114,7 +113,7 @@ class Sphere final : public PostStepEffect {
   std::string_view name() const override { return "sphere"; }
   void before_step(const World& world) override { start_.record(world); }
   bool each_substep() const override { return true; }
-  void apply(World& world, double dt) override;
+  void apply(World& world, const StepTime& time) override;
   // apply's loop on particles [begin, end) only (as Ground::collide).
   void collide(Particles& p, Index begin, Index end) const;
   const Vec3& centre() const { return centre_; }

@@ -41,8 +41,8 @@ void MovingPins::place(Particles& p, double t) const {
   }
 }
 
-void MovingPins::apply(World& world, double dt) {
-  place(world.particles, world.t + dt);  // world.t is still the step's start time
+void MovingPins::apply(World& world, const StepTime& time) {
+  place(world.particles, time.end());  // where the span it closes ends: t + dt after a step
 }
 
 double MovingPins::energy_scale(const Particles& p, double /*size*/) const {

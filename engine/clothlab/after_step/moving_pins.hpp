@@ -2,7 +2,8 @@
 // (the lecture's "fixed points" that move).
 //
 // A pinned particle has inv_m = 0: no force moves it, and the integrator carries it along at
-// its own velocity v. A path sets both after each step, at the step's end time t + dt:
+// its own velocity v. A path sets both after each step, at the step's end time t + dt
+// (StepTime::end):
 //
 //   x(t) = x0 + d(t),   v(t) = d'(t)     keyframes: offsets d_k at times t_k, linear between
 //   x(t) = c + R(w t) (x0 - c),          a circle: x0 turned about the axis a through c at
@@ -38,7 +39,8 @@ class MovingPins final : public PostStepEffect {
  public:
   explicit MovingPins(std::vector<PinPath> paths) : paths_(std::move(paths)) {}
   std::string_view name() const override { return "moving_pins"; }
-  void apply(World& world, double dt) override;  // places every pin at world.t + dt
+  // Places every pin where its path is when `time` closes: t + dt after a whole step.
+  void apply(World& world, const StepTime& time) override;
   // Each pinned particle at its path's position and velocity at time t [s].
   void place(Particles& p, double t) const;
   // 1/2 M v_top^2: the kinetic energy of particles dragged along at the pins' top speed.

@@ -40,7 +40,7 @@ class Plasticity final : public PostStepEffect {
   Plasticity(SpringDampers& springs, const PlasticLimits& limits)
       : springs_(springs), limits_(limits) {}
   std::string_view name() const override { return "plasticity"; }
-  void apply(World& world, double dt) override;
+  void apply(World& world, const StepTime& time) override;
 
  private:
   SpringDampers& springs_;

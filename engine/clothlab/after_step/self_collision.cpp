@@ -20,7 +20,7 @@ const std::vector<IndexPair>& SelfCollision::detect(const Matrix3X& x, double bo
   return pairs_;
 }
 
-void SelfCollision::apply(World& world, double /*dt*/) {
+void SelfCollision::apply(World& world, const StepTime& /*time*/) {
   Particles& p = world.particles;
   last_passes_ = 0;
   last_pairs_ = 0;

@@ -63,7 +63,7 @@ class SelfCollision final : public PostStepEffect {
   SelfCollision(const SelfContact& contact, int iterations, const Matrix3X& x_rest)
       : contact_(contact), iterations_(iterations), x_rest_(x_rest) {}
   std::string_view name() const override { return "self_collision"; }
-  void apply(World& world, double dt) override;
+  void apply(World& world, const StepTime& time) override;
 
   // Detection alone: rebuilds the hash over x [m] (particles beyond +-bound [m] left out) and
   // returns every pair i < j closer than the thickness that is not excluded at rest.

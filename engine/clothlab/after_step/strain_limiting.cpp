@@ -6,11 +6,11 @@
 
 namespace clothlab {
 
-void StrainLimiting::apply(World& world, double dt) {
+void StrainLimiting::apply(World& world, const StepTime& time) {
   last_sweeps_ = 0;
   const SpringSet& s = springs_.springs();
   Particles& p = world.particles;
-  const double inv_dt = 1.0 / dt;  // [1/s]
+  const double inv_dt = 1.0 / time.h;  // [1/s], over the span the effect closes (a whole step)
   for (int sweep = 0; sweep < iterations_; ++sweep) {
     stop_point();  // many sweeps of a big cloth can take minutes (core/stop.hpp)
     // Gauss-Seidel: each spring sees the corrections of the springs before it in this sweep.

@@ -58,7 +58,7 @@ class StrainLimiting final : public PostStepEffect {
   StrainLimiting(const SpringDampers& springs, const StrainLimits& limits, int iterations)
       : springs_(springs), limits_(limits), iterations_(iterations) {}
   std::string_view name() const override { return "strain_limit"; }
-  void apply(World& world, double dt) override;
+  void apply(World& world, const StepTime& time) override;
 
   int iterations() const { return iterations_; }       // most sweeps in one step
   int last_sweeps() const { return last_sweeps_; }     // sweeps the last step took

@@ -9,7 +9,7 @@
 
 namespace clothlab {
 
-void Tearing::apply(World& world, double /*dt*/) {
+void Tearing::apply(World& world, const StepTime& /*time*/) {
   SpringSet& s = springs_.springs();
   const Matrix3X& x = world.particles.x;
   std::vector<double> strain(s.size());

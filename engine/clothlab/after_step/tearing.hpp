@@ -39,7 +39,7 @@ class Tearing final : public PostStepEffect {
         tear_strain_(tear_strain),
         max_tears_(max_tears) {}
   std::string_view name() const override { return "tearing"; }
-  void apply(World& world, double dt) override;
+  void apply(World& world, const StepTime& time) override;
   // Tears the springs at `positions` (ascending, once each) in `springs`, with what goes with
   // them: what apply() does with the springs select_tears() chose. (A page that reads its scene
   // again tears the new cloth where the old one had torn.)

@@ -12,6 +12,7 @@
 #include <string_view>
 
 #include "clothlab/core/particles.hpp"
+#include "clothlab/core/step_time.hpp"
 
 namespace clothlab {
 
@@ -94,10 +95,11 @@ class PostStepEffect {
   // friction can hold a particle where it stood (ground_collision.hpp).
   virtual void before_step(const World& /*world*/) {}
 
-  // Applies the effect once the integrator has advanced the particles by dt [s]. It gets the
-  // whole world: some post-step effects change more than particles (tearing removes springs
-  // and triangles).
-  virtual void apply(World& world, double dt) = 0;
+  // Applies the effect once the integrator has advanced the particles over the span `time`
+  // closes: the whole step, or a substep for an effect that applies each substep (see below and
+  // step_time.hpp). It gets the whole world: some post-step effects change more than particles
+  // (tearing removes springs and triangles).
+  virtual void apply(World& world, const StepTime& time) = 0;
 
   // The energy [J] this effect can give the particles, as ForceEffect::energy_scale says: a pin
   // that moves can drive them.
@@ -106,9 +108,10 @@ class PostStepEffect {
   // True for a contact with a fixed solid (the ground, a plane, a sphere), which changes each
   // particle from that particle's own state alone. An integrator that splits its step into
   // substeps (XPBD, lesson 12) treats each substep as a step for such an effect: before_step at
-  // the substep's start, apply at its end, so that the cloth meets the solid within a substep
-  // rather than a whole step late. (The world still applies it after the step, as always: that
-  // is the last substep's.) Tearing, plasticity and the others see whole steps.
+  // the substep's start, apply at its end with that substep's StepTime, so that the cloth meets
+  // the solid within a substep rather than a whole step late. The integrator applies substeps 0
+  // to n-2; World::step applies the last, n-1, after the step as always. Tearing, plasticity and
+  // the others see whole steps (StepTime::whole).
   virtual bool each_substep() const { return false; }
 };
 

@@ -6,8 +6,8 @@
 
 #include <fmt/format.h>
 
+#include "clothlab/core/integrator.hpp"
 #include "clothlab/core/world.hpp"
-#include "clothlab/integrators/integrator.hpp"
 
 namespace clothlab {
 

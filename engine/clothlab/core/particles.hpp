@@ -10,6 +10,13 @@
 
 namespace clothlab {
 
+// The position r [m] and velocity v [m/s] of one particle: what a one-particle kernel returns
+// (lesson 01's Euler steps, lesson 05's collision response).
+struct PointState {
+  Vec3 r;
+  Vec3 v;
+};
+
 struct Particles {
   Matrix3X x;     // positions r [m]
   Matrix3X v;     // velocities v [m/s]

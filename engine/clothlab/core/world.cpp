@@ -1,37 +1,8 @@
 #include "clothlab/core/world.hpp"
 
 #include <cassert>
-#include <chrono>
 
 namespace clothlab {
-
-namespace {
-
-// Adds the wall time from its making to its end to *slot, and takes it from *less: a part of
-// the step timed for --stats (World::timing). Without a slot it does nothing.
-class Lap {
- public:
-  explicit Lap(double* slot, double* less = nullptr) : slot_(slot), less_(less) {
-    if (slot_) start_ = std::chrono::steady_clock::now();
-  }
-  ~Lap() {
-    if (!slot_) return;
-    const double s =
-        std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
-    *slot_ += s;
-    if (less_) *less_ -= s;
-  }
-  void discard() { slot_ = nullptr; }  // the part did not happen after all: count nothing
-  Lap(const Lap&) = delete;
-  Lap& operator=(const Lap&) = delete;
-
- private:
-  double* slot_;
-  double* less_;
-  std::chrono::steady_clock::time_point start_;
-};
-
-}  // namespace
 
 void World::step(double dt) {
   assert(integrator && "a world needs an integrator before it can step");
@@ -42,43 +13,33 @@ void World::step(double dt) {
     effect->before_step(*this);  // what needs the state the step starts from records it
   // The backend may take the step, or part of it, its own way with the same bits (backend.hpp),
   // checking the state as it goes; it says what it took, and the world does the rest.
-  const BackendStep fast = backend ? backend_step(dt) : BackendStep{};
-  if (!fast.taken) {
-    check(/*before_step=*/true);  // the guard: the state the step starts from
-    advance(dt);                  // 1-3: the integrator sums forces (compute_forces) and moves
+  const BackendStep taken = backend ? backend->step(*this, dt) : BackendStep{};
+  if (!taken.taken) {
+    {
+      const auto timed = lap(timer, &StepTimes::guard);
+      guard.check(*this, /*before_step=*/true);  // the guard: the state the step starts from
+    }
+    const auto timed = lap(timer, &StepTimes::integrator);
+    integrator->advance(*this, dt);  // 1-3: the integrator sums forces (compute_forces) and moves
   }
-  for (size_t k = fast.post_step_done; k < post_step_effects.size(); ++k)
-    apply(k, dt);  // 4: collisions, plasticity, tearing, ...
+  // 4: collisions, plasticity, tearing, ...: a contact closes the integrator's last substep,
+  // every other effect the whole step (the substep contract, world.hpp).
+  const StepTime whole = StepTime::whole(t, dt);
+  const int n = integrator->substeps_per_step();
+  const StepTime last_substep = StepTime::of_substep(t, dt, n - 1, n);
+  for (size_t k = taken.post_step_done; k < post_step_effects.size(); ++k) {
+    const auto timed = lap(timer, k, post_step_effects.size());
+    PostStepEffect& effect = *post_step_effects[k];
+    effect.apply(*this, effect.each_substep() ? last_substep : whole);
+  }
   t += dt;
   ++steps;
-  const bool checked = fast.checked_after && fast.post_step_done == post_step_effects.size();
-  if (!checked) check(/*before_step=*/false);  // 5: the guard: the state the step ends with
+  const bool checked = taken.checked_after && taken.post_step_done == post_step_effects.size();
+  if (!checked) {
+    const auto timed = lap(timer, &StepTimes::guard);
+    guard.check(*this, /*before_step=*/false);  // 5: the guard: the state the step ends with
+  }
   if (steps % guard.energy_check_every == 0) guard.check_energy(*this);
-}
-
-// The parts of the step, each timed for --stats when World::timing is set.
-
-BackendStep World::backend_step(double dt) {
-  Lap lap(timing ? &timing->backend_steps : nullptr);
-  const BackendStep taken = backend->step(*this, dt);
-  if (!taken.taken) lap.discard();
-  return taken;
-}
-
-void World::check(bool before_step) const {
-  Lap lap(timing ? &timing->guard : nullptr);
-  guard.check(*this, before_step);
-}
-
-void World::advance(double dt) {
-  Lap lap(timing ? &timing->integrator : nullptr);  // compute_forces takes its own time out
-  integrator->advance(*this, dt);
-}
-
-void World::apply(size_t k, double dt) {
-  if (timing) timing->post_step_effects.resize(post_step_effects.size(), 0.0);
-  Lap lap(timing ? &timing->post_step_effects[k] : nullptr);
-  post_step_effects[k]->apply(*this, dt);
 }
 
 ThreadTeam* World::team() const {
@@ -88,16 +49,14 @@ ThreadTeam* World::team() const {
 }
 
 void World::compute_forces(const Matrix3X& x, const Matrix3X& v, Matrix3X& f) const {
-  if (backend) {
-    Lap lap(timing ? &timing->backend_forces : nullptr, timing ? &timing->integrator : nullptr);
-    if (backend->sum_forces(*this, x, v, f)) {
-      ++force_evaluations;
-      ++fast_evaluations;
-      return;
-    }
-    lap.discard();
+  if (backend && backend->sum_forces(*this, x, v, f)) {
+    ++force_evaluations;
+    ++backend_evaluations;
+  } else if (timer) {
+    timer->sum_forces(*this, x, v, f);  // --stats: the loop below, each effect timed
+  } else {
+    compute_forces_readable(x, v, f);
   }
-  compute_forces_readable(x, v, f);
 }
 
 void World::for_particles(const std::function<void(Index begin, Index end)>& range) const {
@@ -111,11 +70,8 @@ void World::for_items(Index n, const std::function<void(Index begin, Index end)>
 void World::compute_forces_readable(const Matrix3X& x, const Matrix3X& v, Matrix3X& f) const {
   f.setZero();
   ++force_evaluations;
-  if (timing) timing->force_effects.resize(force_effects.size(), 0.0);
-  for (size_t k = 0; k < force_effects.size(); ++k) {
-    Lap lap(timing ? &timing->force_effects[k] : nullptr, timing ? &timing->integrator : nullptr);
-    force_effects[k]->add_forces(particles, x, v, f);
-  }
+  for (const auto& effect : force_effects)
+    effect->add_forces(particles, x, v, f);
 }
 
 double World::kinetic_energy() const {

@@ -1,13 +1,24 @@
 // world.hpp: the particles, the effects a scene named, and the step that ties them together.
 //
-// One step, in the lecture's order (after the effects have been told the time, set_time, and
-// have recorded what they need of the state the step starts from, before_step):
+// One step of dt from time t, in the lecture's order (after the effects have been told the time,
+// set_time, and have recorded what they need of the state the step starts from, before_step):
 //   1. clear the force accumulators;
 //   2. every force effect adds its forces;
 //   3. the integrator advances positions and velocities (re-evaluating 1-2 if it needs to);
 //   4. every post-step effect applies (collisions, plasticity, tearing);
 //   5. the guard checks that the state is still finite and bounded (and it checked it before 1).
 // A backend (backend.hpp) may take some of it another way, with the same result, bit for bit.
+//
+// Substeps, and the time each post-step effect is told (step_time.hpp). An integrator may split
+// the step into n = Integrator::substeps_per_step() substeps of h = dt / n (XPBD, lesson 12).
+//   - A contact with a fixed solid (PostStepEffect::each_substep: ground, plane, sphere) applies
+//     after every substep: the integrator calls before_step at the start of substeps 1 to n-1 and
+//     apply at the end of substeps 0 to n-2, with StepTime::of_substep(t, dt, k, n); World::step
+//     calls before_step for substep 0 (above) and apply for substep n-1, after the integrator.
+//   - Every other post-step effect (pins that move, plasticity, tearing, strain limiting,
+//     self-collision) applies once, in World::step, with StepTime::whole(t, dt): h = dt.
+// With n = 1 the two are the same: substep 0 of 1, h = dt. World::t stays t until every
+// post-step effect has applied; StepTime::end() says when the span an application closes ends.
 #pragma once
 
 #include <functional>
@@ -18,23 +29,13 @@
 #include "clothlab/core/backend.hpp"
 #include "clothlab/core/effect.hpp"
 #include "clothlab/core/guard.hpp"
+#include "clothlab/core/integrator.hpp"
 #include "clothlab/core/particles.hpp"
+#include "clothlab/core/step_timer.hpp"
 #include "clothlab/core/threads.hpp"
 #include "clothlab/core/triangles.hpp"
-#include "clothlab/integrators/integrator.hpp"
 
 namespace clothlab {
-
-// Wall time spent in each part of the step, filled in when World::timing points at it. Force
-// effects and post-step effects are listed in the world's order.
-struct StepTimes {
-  std::vector<double> force_effects;      // [s] each force effect, in the sums the world made
-  std::vector<double> post_step_effects;  // [s] each post-step effect the world applied
-  double integrator = 0.0;                // [s] the integrator's own work, forces excluded
-  double guard = 0.0;                     // [s] the guard's checks
-  double backend_forces = 0.0;            // [s] force sums the backend made, every effect at once
-  double backend_steps = 0.0;             // [s] what the backend took of the steps (BackendStep)
-};
 
 class World {
  public:
@@ -54,17 +55,17 @@ class World {
 
   // How often compute_forces has run: what a multi-stage integrator pays per step.
   mutable long force_evaluations = 0;
-  mutable long fast_evaluations = 0;  // how many of them the backend made
+  mutable long backend_evaluations = 0;  // how many of them the backend made
 
-  // When set (by `clothlab run --stats`), each step adds the time of each of its parts here,
-  // on whichever path it takes. The check costs one branch per part, never one per particle.
-  StepTimes* timing = nullptr;
+  // When set (StepTimer::attach, by `clothlab run --stats`), each step adds the time of each of
+  // its parts there, on whichever path it takes (step_timer.hpp).
+  StepTimer* timer = nullptr;
 
   // Threads a step may use (the backend, the guard); 1: this one only. ([engine] threads in a
   // scene, `clothlab run --threads N`.)
   int threads = 1;
 
-  // Takes one step of dt [s] (steps 1-5 above).
+  // Takes one step of dt [s] (steps 1-5 and the substep contract above).
   void step(double dt);
 
   // Steps 1-2 at an arbitrary state: f = sum of every force effect at (x, v) [N]. The backend
@@ -91,12 +92,6 @@ class World {
   std::string effects_in_play() const;
 
  private:
-  // The parts of step(), each timed when timing is set.
-  BackendStep backend_step(double dt);  // what the backend takes of it
-  void check(bool before_step) const;   // the guard's check of the state
-  void advance(double dt);              // the integrator's advance
-  void apply(size_t k, double dt);      // post-step effect k
-
   ThreadTeam* team() const;  // the threads of a step, or null for one thread
 
   mutable std::unique_ptr<ThreadTeam> team_;

@@ -12,16 +12,10 @@
 // We pass the inverse mass 1/m rather than m so that a pinned particle is simply 1/m = 0.
 #pragma once
 
-#include "clothlab/core/types.hpp"
-#include "clothlab/integrators/integrator.hpp"
+#include "clothlab/core/integrator.hpp"
+#include "clothlab/core/particles.hpp"
 
 namespace clothlab {
-
-// The position [m] and velocity [m/s] of one particle after a step.
-struct PointState {
-  Vec3 r;
-  Vec3 v;
-};
 
 // Exercise ex01.3: one explicit Euler step of dt [s] for a particle at r [m] with velocity
 // v [m/s], total force f [N] and inverse mass inv_m [1/kg].

@@ -29,8 +29,8 @@
 #include <vector>
 
 #include "clothlab/core/effect.hpp"
+#include "clothlab/core/integrator.hpp"
 #include "clothlab/core/types.hpp"
-#include "clothlab/integrators/integrator.hpp"
 
 namespace clothlab {
 

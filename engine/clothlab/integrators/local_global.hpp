@@ -38,8 +38,8 @@
 #include <Eigen/SparseCore>
 #include <vector>
 
+#include "clothlab/core/integrator.hpp"
 #include "clothlab/core/types.hpp"
-#include "clothlab/integrators/integrator.hpp"
 
 namespace clothlab {
 

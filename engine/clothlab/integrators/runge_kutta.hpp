@@ -25,8 +25,8 @@
 #include <array>
 #include <functional>
 
+#include "clothlab/core/integrator.hpp"
 #include "clothlab/core/types.hpp"
-#include "clothlab/integrators/integrator.hpp"
 
 namespace clothlab {
 

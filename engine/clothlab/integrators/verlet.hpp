@@ -26,8 +26,8 @@
 // position and velocity, x_prev = x - dt v + dt^2/2 a, which is also how the first step starts.
 #pragma once
 
+#include "clothlab/core/integrator.hpp"
 #include "clothlab/core/types.hpp"
-#include "clothlab/integrators/integrator.hpp"
 
 namespace clothlab {
 

@@ -172,8 +172,9 @@ void Xpbd::advance(World& world, double dt) {
     // The velocity the particles moved at over the substep.
     p.v = (p.x - x_old_) / h;
     if (s + 1 < substeps) {
+      const StepTime substep = StepTime::of_substep(world.t, dt, s, substeps);
       for (PostStepEffect* contact : contacts)
-        contact->apply(world, h);
+        contact->apply(world, substep);
     }
   }
 }

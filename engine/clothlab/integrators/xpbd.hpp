@@ -31,8 +31,10 @@
 //   repeat `iterations` times: project every constraint (above), in order
 //   v      = (x - x_old) / dt_s
 //   the contacts with fixed solids ([ground], [[plane]], [sphere]), as after a step
-// (PostStepEffect::each_substep; World::step applies the last substep's with the other post-step
-// effects, which see whole steps: tearing, plasticity, strain limiting, self-collision).
+// (PostStepEffect::each_substep), told that they close substep s of `substeps`, of dt_s
+// (StepTime::of_substep). advance() applies them after substeps 0 to substeps - 2; World::step
+// applies the last substep's with the other post-step effects, which see whole steps (tearing,
+// plasticity, strain limiting, self-collision, moving pins).
 // A pinned particle has w = 0: the prediction moves it by dt_s v only (a moving pin's velocity)
 // and no projection moves it.
 //
@@ -50,8 +52,8 @@
 #include <cstdint>
 #include <vector>
 
+#include "clothlab/core/integrator.hpp"
 #include "clothlab/core/types.hpp"
-#include "clothlab/integrators/integrator.hpp"
 
 namespace clothlab {
 
@@ -128,6 +130,7 @@ class Xpbd final : public Integrator {
   void advance(World& world, double dt) override;
   // The external forces are summed once per substep.
   int force_evaluations_per_step() const override { return substeps; }
+  int substeps_per_step() const override { return substeps; }
   std::string_view springs_without_dt_limit() const override { return "as constraints"; }
 
   int substeps = 10;   // substeps per step ([integrator] substeps)
