@@ -36,6 +36,14 @@ class TimedBackend final : public Backend {
     return inner_->xpbd_project(world, constraints, x_old, h, iterations, keep_lambda, lambda);
   }
 
+  bool implicit_euler_step(World& world, double dt, double tolerance, int max_iterations,
+                           VectorX& dv, LinearSolveStats& stats) override {
+    StepTimer::Lap lap(&timer_.times.backend_steps);
+    const bool taken = inner_->implicit_euler_step(world, dt, tolerance, max_iterations, dv, stats);
+    if (!taken) lap.discard();
+    return taken;
+  }
+
  private:
   std::unique_ptr<Backend> inner_;
   StepTimer& timer_;
