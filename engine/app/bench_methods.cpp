@@ -125,8 +125,8 @@ std::vector<Ladder> ladders(bool quick, bool large) {
       {"rk4", true, {1, 2, 4}},
       {"implicit-euler", false, {1, 2, 4, 8, 16, 32}},
       {"xpbd", false, {1}, {{1, 1}, {4, 1}, {16, 1}, {64, 1}, {256, 1}, {1, 4}, {1, 16}, {1, 64}}},
-      // 64 substeps a frame again, in 8 steps: the post-step effects (colliders) act after
-      // every step, not every substep, so this is how a collider sees XPBD's small steps.
+      // 64 substeps a frame again, in 8 steps of 8: colliders act after every substep either
+      // way (world.hpp's substep contract); the effects that act once a step see 8 steps.
       {"xpbd", false, {8}, {{8, 1}}},
       {"local-global", false, {1, 2, 4, 8, 16}, {{0, 10}}}};
 }
