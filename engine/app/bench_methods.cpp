@@ -31,12 +31,14 @@
 
 #include <fmt/format.h>
 #include <toml++/toml.h>
+#include <Eigen/CholmodSupport>
 
 #include "analysis/stability.hpp"
 #include "app/bench.hpp"
 #include "clothlab/core/guard.hpp"
 #include "clothlab/forces/spring_damper.hpp"
 #include "clothlab/integrators/integrator.hpp"
+#include "clothlab/integrators/local_global.hpp"
 #include "io/files.hpp"
 #include "scene/scene.hpp"
 
@@ -349,7 +351,47 @@ struct SpeedRow {
   int grid = 0, threads = 0;
   size_t springs = 0;
   double euler[2] = {}, xpbd_one[2] = {}, xpbd_iteration[2] = {};  // [readable, engine room]
+  // A local/global iteration [readable, engine room], and its solve alone in the engine room
+  // (CHOLMOD's, three right-hand sides): the part the threads do not share.
+  double lg_iteration[2] = {}, lg_solve = 0.0;
 };
+
+// A local/global iteration's cost: steps of 1 + kLgMore iterations against steps of 1 (the
+// factorisation, on the first step, is in both), on few steps, since a 256 x 256 cloth's
+// readable iteration takes a tenth of a second; and the engine room's solve alone, timed on the
+// matrix the integrator built.
+void measure_local_global(SpeedRow& row, int grid, int threads, bool quick) {
+  const int steps = quick ? 2 : 5, repeats = quick ? 1 : 3;
+  constexpr int kLgMore = 4;
+  const double per = 1e9 / (static_cast<double>(row.springs) * steps);
+  const auto text = [&](int iterations) {
+    return speed_scene(grid, "local-global", 0, 0) + fmt::format("iterations = {}\n", iterations);
+  };
+  for (int fast = 0; fast < 2; ++fast) {
+    const double one = per * time_steps(text(1), steps, repeats, threads, fast == 1);
+    const double many = per * time_steps(text(1 + kLgMore), steps, repeats, threads, fast == 1);
+    row.lg_iteration[fast] = (many - one) / kLgMore;
+  }
+  World world = std::move(parse_scene(text(1), "<speed>").world);
+  world.step(1e-4);
+  const auto* lg = dynamic_cast<const LocalGlobal*>(world.integrator.get());
+  if (!lg) return;
+  Eigen::CholmodSimplicialLLT<Eigen::SparseMatrix<double>> llt;
+  llt.cholmod().nmethods = 1;
+  llt.cholmod().method[0].ordering = CHOLMOD_AMD;
+  llt.compute(lg->system().a);
+  const Eigen::Matrix<double, Eigen::Dynamic, 3> b =
+      Eigen::Matrix<double, Eigen::Dynamic, 3>::Ones(lg->system().a.rows(), 3);
+  Eigen::Matrix<double, Eigen::Dynamic, 3> x;
+  const int solves = quick ? 3 : 10;
+  double best = std::numeric_limits<double>::infinity();
+  for (int r = 0; r < solves; ++r) {
+    const Clock::time_point start = Clock::now();
+    x = llt.solve(b);
+    best = std::min(best, std::chrono::duration<double>(Clock::now() - start).count());
+  }
+  row.lg_solve = 1e9 * best / static_cast<double>(row.springs);
+}
 
 SpeedRow measure_speed(int grid, int threads, bool quick) {
   const int steps = quick ? 5 : 40, repeats = quick ? 2 : 5;
@@ -372,6 +414,7 @@ SpeedRow measure_speed(int grid, int threads, bool quick) {
     const double many = time(speed_scene(grid, "xpbd", 1, 1 + kMore));
     row.xpbd_iteration[fast] = (many - row.xpbd_one[fast]) / kMore;
   }
+  measure_local_global(row, grid, threads, quick);
   return row;
 }
 
@@ -399,6 +442,15 @@ void speed(const MethodsOptions& opt, const fs::path& out_dir) {
       rows.push_back(r);
     }
   }
+  fmt::print("  {:>9} {:>7} | {:>21} | {:>14} | {:>14}\n", "grid", "threads",
+             "local/global iteration", "LG it./step", "solve alone");
+  fmt::print("  {:>9} {:>7} | {:>10} {:>10} | {:>14} | {:>14}\n", "", "", "readable", "engine",
+             "engine (<=4)", "engine");
+  for (const SpeedRow& r : rows) {
+    fmt::print("  {:>9} {:>7} | {:10.2f} {:10.2f} | {:14.2f} | {:14.2f}\n",
+               fmt::format("{0} x {0}", r.grid), r.threads, r.lg_iteration[0], r.lg_iteration[1],
+               r.lg_iteration[1] / r.euler[1], r.lg_solve);
+  }
   // The targets, as ratios measured in this run.
   fmt::print(
       "  targets (one thread, engine room): an XPBD iteration <= 1.5 symplectic Euler "
@@ -417,6 +469,26 @@ void speed(const MethodsOptions& opt, const fs::path& out_dir) {
     }
     fmt::print("\n");
   }
+  for (const SpeedRow& one : rows) {
+    if (one.threads != 1) continue;
+    const double ratio = one.lg_iteration[1] / one.euler[1];
+    // The bound: the solve alone, on one thread whatever the threads (CHOLMOD's triangular
+    // solves), against the Euler step.
+    fmt::print(
+        "  {0} x {0}: local/global iteration / Euler step = {1:.2f} ({2}; the solve alone "
+        "{3:.2f})",
+        one.grid, ratio, ratio <= 4.0 ? "met" : "missed", one.lg_solve / one.euler[1]);
+    for (const SpeedRow& two : rows) {
+      if (two.grid != one.grid || two.threads != 2) continue;
+      const double lg = one.lg_iteration[1] / two.lg_iteration[1];
+      // Amdahl: with the solve on one thread, 2 threads gain at most it / (solve + rest / 2).
+      const double most = one.lg_iteration[1] /
+                          (one.lg_solve + std::max(0.0, one.lg_iteration[1] - one.lg_solve) / 2);
+      fmt::print("; 2 threads over 1: {:.2f}{} (at most {:.2f} with the solve on one thread)", lg,
+                 one.grid == 128 ? (lg >= 1.7 ? " (met)" : " (missed)") : "", most);
+    }
+    fmt::print("\n");
+  }
   std::string table = "grid,springs,measure,ns_per_spring,threads\n";
   for (const SpeedRow& r : rows) {
     for (int fast = 0; fast < 2; ++fast) {
@@ -428,6 +500,7 @@ void speed(const MethodsOptions& opt, const fs::path& out_dir) {
       add("symplectic-euler-step", r.euler[fast]);
       add("xpbd-substep-1-iteration", r.xpbd_one[fast]);
       add("xpbd-iteration", r.xpbd_iteration[fast]);
+      add("local-global-iteration", r.lg_iteration[fast]);
     }
   }
   write_whole_file(out_dir / "speed.csv", table);

@@ -30,7 +30,8 @@
 //
 // Of an XPBD step it takes the projections only (xpbd_project, in xpbd.cpp): colour by colour
 // of the integrator's constraint colouring, each colour split over the threads, with the bits
-// of the integrator's own loop.
+// of the integrator's own loop. Of a local/global step, the iterations (local_global.cpp): the
+// local steps and right-hand sides with the integrator's bits, the solves by CHOLMOD.
 #pragma once
 
 #include <functional>
@@ -62,6 +63,8 @@ inline constexpr Index kPassChunk = 512;
 // per block (32 for a 256-wide cloth). SPEED.md has the measurements behind the size.
 inline constexpr Index kPassBlock = 8192;
 
+struct LocalGlobalRoom;  // local_global.cpp
+
 class FastEngine final : public Backend {
  public:
   // Particles a thread sums and moves at once in a step's one pass (kPassBlock). Any value
@@ -78,6 +81,12 @@ class FastEngine final : public Backend {
   bool xpbd_project(World& world, const XpbdConstraints& constraints, const Matrix3X& x_old,
                     double h, int iterations, bool keep_lambda,
                     std::vector<double>& lambda) override;
+#if defined(CLOTHLAB_CHOLMOD)
+  // The local/global solver's iterations (local_global.cpp): the local step and the right-hand
+  // side in the fast layout on the threads, the solve by CHOLMOD. Not in the web module, which
+  // has no CHOLMOD: there the integrator's own loop runs.
+  bool local_global_iterate(World& world, LocalGlobalSystem& system, int iterations) override;
+#endif
 
   // Which of the world's force effects it summed itself in its last evaluation ("gravity+
   // springs+ buoyancy-"), for tests and for `clothlab bench`.
@@ -124,6 +133,8 @@ class FastEngine final : public Backend {
   std::vector<Contact> contacts_;
   Copies copies_;
   SoA3 xpbd_x_, xpbd_old_;  // x and x_old in the fast layout, for XPBD's projections
+  // The local/global solver's factor and buffers (local_global.cpp), made on its first step.
+  std::shared_ptr<LocalGlobalRoom> local_global_;
 };
 
 // A world's fast engine: what a scene installs as World::backend.

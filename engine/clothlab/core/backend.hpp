@@ -19,6 +19,7 @@ namespace clothlab {
 
 class World;
 struct XpbdConstraints;
+struct LocalGlobalSystem;
 
 // What a backend took of a step (Backend::step).
 struct BackendStep {
@@ -51,6 +52,17 @@ class Backend {
   virtual bool xpbd_project(World& /*world*/, const XpbdConstraints& /*constraints*/,
                             const Matrix3X& /*x_old*/, double /*h*/, int /*iterations*/,
                             bool /*keep_lambda*/, std::vector<double>& /*lambda*/) {
+    return false;
+  }
+
+  // The local/global solver's iterations of one step (integrators/local_global.hpp): each time,
+  // every spring's d from world.particles.x (the local step, into system.d), then the global
+  // step's solve of system.a x = b_fixed + J d, written to the free particles' x. The same
+  // local steps and right-hand sides as LocalGlobal::advance's own loop; the solve may be
+  // another factorisation of the same matrix (the result within the tolerance tests/fast/
+  // derives). False: declined, nothing changed.
+  virtual bool local_global_iterate(World& /*world*/, LocalGlobalSystem& /*system*/,
+                                    int /*iterations*/) {
     return false;
   }
 };
