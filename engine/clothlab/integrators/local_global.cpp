@@ -1,5 +1,6 @@
 #include "clothlab/integrators/local_global.hpp"
 
+#include <atomic>
 #include <stdexcept>
 
 #include "clothlab/core/backend.hpp"
@@ -81,7 +82,10 @@ void LocalGlobal::factor(const World& world, double dt) {
   Eigen::SparseMatrix<double>& a = system_.a;
   a.resize(unknowns, unknowns);
   a.setFromTriplets(triplets.begin(), triplets.end());  // adds up repeated entries
-  ++system_.version;
+  // A number no other system has had in this process, so that a backend holding the factor of
+  // an earlier system (another integrator's, at the same address, say) sees this one as new.
+  static std::atomic<long> systems_built{0};
+  system_.version = ++systems_built;
   llt_.compute(a);
   // Every mass is positive and every c >= 0, so A is symmetric positive definite: a failure
   // here is a bug, not a scene to reject.
