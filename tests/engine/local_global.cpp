@@ -364,22 +364,14 @@ TEST_CASE("local-global: scenes read iterations and run with pins and colliders"
 // another factorisation, so the states agree within rounding (tests/fast/ derives the bound for
 // its cloth and checks the local steps bit for bit).
 TEST_CASE("local-global: the fast path takes the iterations only, within the solves' rounding") {
-  const std::string text = test::storm() + "method = \"local-global\"\n";
-  clothlab::Scene fast = clothlab::parse_scene(text, "fast.toml");
-  clothlab::Scene readable = clothlab::parse_scene(text, "readable.toml");
-  readable.world.backend.reset();
-  REQUIRE(fast.world.backend != nullptr);
-  clothlab::StepTimes times;
-  fast.world.timing = &times;
   const int steps = 200;
-  for (int s = 0; s < steps; ++s) {
-    fast.world.step(fast.dt);
-    readable.world.step(readable.dt);
-  }
-  CHECK(times.backend_steps == 0.0);
+  const auto both =
+      test::step_fast_and_readable(test::storm() + "method = \"local-global\"\n", steps);
+  const clothlab::Scene &fast = both->fast, &readable = both->readable;
+  CHECK(both->times.backend_steps == 0.0);
   CHECK(fast.world.fast_evaluations == 0);
-  CHECK(dynamic_cast<LocalGlobal&>(*fast.world.integrator).backend_steps == steps);
-  CHECK(dynamic_cast<LocalGlobal&>(*readable.world.integrator).backend_steps == 0);
+  CHECK(dynamic_cast<const LocalGlobal&>(*fast.world.integrator).backend_steps == steps);
+  CHECK(dynamic_cast<const LocalGlobal&>(*readable.world.integrator).backend_steps == 0);
   const double dx = (fast.world.particles.x - readable.world.particles.x).cwiseAbs().maxCoeff();
   MESSAGE("positions differ by " << dx << " m");
   CHECK(dx <= 1e-9);
