@@ -52,6 +52,10 @@ set(CLOTHLAB_FAST_SOURCES
   fast/aerodynamics.cpp
   fast/xpbd.cpp
   fast/implicit.cpp)
+# The engine room's parts that need CHOLMOD (libsuitesparse-dev): the native build only. The web
+# module (engine/web/) leaves them out and runs the lecture's local/global loop, on Eigen's solver.
+set(CLOTHLAB_FAST_CHOLMOD_SOURCES
+  fast/local_global.cpp)
 # What only the native program needs: runs, their files and the viewer page.
 set(CLOTHLAB_IO_SOURCES
   io/run.cpp

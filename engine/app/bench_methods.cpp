@@ -17,9 +17,9 @@
 // CSV, and a plot per scene drawn by a small matplotlib script written next to it.
 //
 // `--speed`: on cloths of 64 x 64, 128 x 128 and 256 x 256 particles, on 1 and 2 threads, what
-// a symplectic Euler step and an XPBD iteration cost per spring, each on the readable path (no
-// backend) and in the engine room (engine/fast/), measured in the same run, and the issue's
-// targets beside the ratios.
+// a symplectic Euler step, an XPBD iteration and a local/global iteration cost per spring, each
+// on the readable path (no backend) and in the engine room (engine/fast/), measured in the same
+// run, and the targets beside the ratios.
 //
 // Implicit Euler's rows: ns per spring per conjugate-gradient iteration, readable and engine
 // room, with the iterations per step, and a streaming pass over as many bytes as the bound.
@@ -35,6 +35,7 @@
 
 #include <fmt/format.h>
 #include <toml++/toml.h>
+#include <Eigen/CholmodSupport>
 
 #include "analysis/stability.hpp"
 #include "app/bench.hpp"
@@ -42,6 +43,7 @@
 #include "clothlab/core/threads.hpp"
 #include "clothlab/forces/spring_damper.hpp"
 #include "clothlab/integrators/implicit_euler.hpp"
+#include "clothlab/integrators/local_global.hpp"
 #include "clothlab/integrators/methods.hpp"
 #include "io/files.hpp"
 #include "scene/scene.hpp"
@@ -371,13 +373,17 @@ std::string speed_scene(int grid, std::string_view method, int substeps, int ite
 }
 
 // The fastest of `repeats` wall times [s] of `steps` steps of the scene on `threads` threads,
-// in the engine room (`fast`) or on the readable path alone.
-double time_steps(const std::string& text, int steps, int repeats, int threads, bool fast) {
+// in the engine room (`fast`) or on the readable path alone, after `untimed` steps (a
+// factorisation on the first step, say).
+double time_steps(const std::string& text, int steps, int repeats, int threads, bool fast,
+                  int untimed = 0) {
   double best = std::numeric_limits<double>::infinity();
   for (int r = 0; r < repeats; ++r) {
     World world = std::move(parse_scene(text, "<speed>").world);
     if (!fast) world.backend.reset();
     world.threads = threads;
+    for (int s = 0; s < untimed; ++s)
+      world.step(1e-4);
     const Clock::time_point start = Clock::now();
     for (int s = 0; s < steps; ++s)
       world.step(1e-4);
@@ -441,7 +447,47 @@ struct SpeedRow {
 
   // Implicit Euler: ns per spring per conjugate-gradient iteration, and iterations per step.
   double cg_iteration[2] = {}, cg_iterations[2] = {};
+  // A local/global iteration [readable, engine room], and its solve alone in the engine room
+  // (CHOLMOD's, three right-hand sides): the part the threads do not share.
+  double lg_iteration[2] = {}, lg_solve = 0.0;
 };
+
+// A local/global iteration's cost: steps of 1 + kLgMore iterations against steps of 1, after a
+// first step that factors the matrix (untimed), on few steps, since a 256 x 256 cloth's
+// readable iteration takes a tenth of a second; and the engine room's solve alone, timed on the
+// matrix the integrator built.
+void measure_local_global(SpeedRow& row, int grid, int threads, bool quick) {
+  const int steps = quick ? 2 : 5, repeats = quick ? 1 : 3;
+  constexpr int kLgMore = 4;
+  const double per = 1e9 / (static_cast<double>(row.springs) * steps);
+  const auto text = [&](int iterations) {
+    return speed_scene(grid, "local-global", 0, 0) + fmt::format("iterations = {}\n", iterations);
+  };
+  for (int fast = 0; fast < 2; ++fast) {
+    const double one = per * time_steps(text(1), steps, repeats, threads, fast == 1, 1);
+    const double many = per * time_steps(text(1 + kLgMore), steps, repeats, threads, fast == 1, 1);
+    row.lg_iteration[fast] = (many - one) / kLgMore;
+  }
+  World world = std::move(parse_scene(text(1), "<speed>").world);
+  world.step(1e-4);
+  const auto* lg = dynamic_cast<const LocalGlobal*>(world.integrator.get());
+  if (!lg) return;
+  Eigen::CholmodSimplicialLLT<Eigen::SparseMatrix<double>> llt;
+  llt.cholmod().nmethods = 1;
+  llt.cholmod().method[0].ordering = CHOLMOD_AMD;
+  llt.compute(lg->system().a);
+  const Eigen::Matrix<double, Eigen::Dynamic, 3> b =
+      Eigen::Matrix<double, Eigen::Dynamic, 3>::Ones(lg->system().a.rows(), 3);
+  Eigen::Matrix<double, Eigen::Dynamic, 3> x;
+  const int solves = quick ? 3 : 10;
+  double best = std::numeric_limits<double>::infinity();
+  for (int r = 0; r < solves; ++r) {
+    const Clock::time_point start = Clock::now();
+    x = llt.solve(b);
+    best = std::min(best, std::chrono::duration<double>(Clock::now() - start).count());
+  }
+  row.lg_solve = 1e9 * best / static_cast<double>(row.springs);
+}
 
 SpeedRow measure_speed(int grid, int threads, bool quick) {
   const int steps = quick ? 5 : 40, repeats = quick ? 2 : 5;
@@ -470,6 +516,7 @@ SpeedRow measure_speed(int grid, int threads, bool quick) {
     row.cg_iteration[fast] = 1e9 * cg.seconds_per_iteration / static_cast<double>(row.springs);
     row.cg_iterations[fast] = cg.iterations_per_step;
   }
+  measure_local_global(row, grid, threads, quick);
   return row;
 }
 
@@ -497,6 +544,15 @@ void speed(const MethodsOptions& opt, const fs::path& out_dir) {
       rows.push_back(r);
     }
   }
+  fmt::print("  {:>9} {:>7} | {:>21} | {:>14} | {:>14}\n", "grid", "threads",
+             "local/global iteration", "LG it./step", "solve alone");
+  fmt::print("  {:>9} {:>7} | {:>10} {:>10} | {:>14} | {:>14}\n", "", "", "readable", "engine",
+             "engine (<=4)", "engine");
+  for (const SpeedRow& r : rows) {
+    fmt::print("  {:>9} {:>7} | {:10.2f} {:10.2f} | {:14.2f} | {:14.2f}\n",
+               fmt::format("{0} x {0}", r.grid), r.threads, r.lg_iteration[0], r.lg_iteration[1],
+               r.lg_iteration[1] / r.euler[1], r.lg_solve);
+  }
   // The targets, as ratios measured in this run.
   fmt::print(
       "  targets (one thread, engine room): an XPBD iteration <= 1.5 symplectic Euler "
@@ -512,6 +568,26 @@ void speed(const MethodsOptions& opt, const fs::path& out_dir) {
                    xpbd = one.xpbd_iteration[1] / two.xpbd_iteration[1];
       fmt::print("; 2 threads over 1: Euler {:.2f}, XPBD {:.2f}{}", euler, xpbd,
                  one.grid == 128 ? (euler >= 1.7 && xpbd >= 1.7 ? " (met)" : " (missed)") : "");
+    }
+    fmt::print("\n");
+  }
+  for (const SpeedRow& one : rows) {
+    if (one.threads != 1) continue;
+    const double ratio = one.lg_iteration[1] / one.euler[1];
+    // The bound: the solve alone, on one thread whatever the threads (CHOLMOD's triangular
+    // solves), against the Euler step.
+    fmt::print(
+        "  {0} x {0}: local/global iteration / Euler step = {1:.2f} ({2}; the solve alone "
+        "{3:.2f})",
+        one.grid, ratio, ratio <= 4.0 ? "met" : "missed", one.lg_solve / one.euler[1]);
+    for (const SpeedRow& two : rows) {
+      if (two.grid != one.grid || two.threads != 2) continue;
+      const double lg = one.lg_iteration[1] / two.lg_iteration[1];
+      // Amdahl: with the solve on one thread, 2 threads gain at most it / (solve + rest / 2).
+      const double most = one.lg_iteration[1] /
+                          (one.lg_solve + std::max(0.0, one.lg_iteration[1] - one.lg_solve) / 2);
+      fmt::print("; 2 threads over 1: {:.2f}{} (at most {:.2f} with the solve on one thread)", lg,
+                 one.grid == 128 ? (lg >= 1.7 ? " (met)" : " (missed)") : "", most);
     }
     fmt::print("\n");
   }
@@ -564,6 +640,7 @@ void speed(const MethodsOptions& opt, const fs::path& out_dir) {
       add("xpbd-iteration", r.xpbd_iteration[fast]);
 
       add("implicit-euler-cg-iteration", r.cg_iteration[fast]);
+      add("local-global-iteration", r.lg_iteration[fast]);
     }
   }
   write_whole_file(out_dir / "speed.csv", table);
@@ -658,8 +735,8 @@ void add_bench_methods_command(CLI::App& bench) {
       ->check(CLI::PositiveNumber)
       ->capture_default_str();
   methods->add_flag("--speed", options.speed,
-                    "Also time a symplectic Euler step and an XPBD iteration per spring, readable "
-                    "and engine room, on 1 and 2 threads");
+                    "Also time a symplectic Euler step, an XPBD iteration and a local/global "
+                    "iteration per spring, readable and engine room, on 1 and 2 threads");
   methods
       ->add_option("--grid", options.grids,
                    "The speed measurement's cloths: N x N particles (one or more N)")

@@ -34,6 +34,9 @@
 //
 // Of an implicit Euler step it takes the whole (implicit_euler_step, in implicit.cpp): the
 // Jacobians spring by spring and a matrix-free conjugate-gradient solve on the threads.
+//
+// Of a local/global step it takes the iterations (local_global.cpp): the local steps and
+// right-hand sides with the integrator's bits, the solves by CHOLMOD.
 #pragma once
 
 #include <functional>
@@ -66,6 +69,7 @@ inline constexpr Index kPassChunk = 512;
 inline constexpr Index kPassBlock = 8192;
 
 struct ImplicitSolver;
+struct LocalGlobalRoom;  // local_global.cpp
 
 class FastEngine final : public Backend {
  public:
@@ -91,6 +95,12 @@ class FastEngine final : public Backend {
                     std::vector<double>& lambda) override;
   bool implicit_euler_step(World& world, double dt, double tolerance, int max_iterations,
                            VectorX& dv, LinearSolveStats& stats) override;
+#if defined(CLOTHLAB_CHOLMOD)
+  // The local/global solver's iterations (local_global.cpp): the local step and the right-hand
+  // side in the fast layout on the threads, the solve by CHOLMOD. Not in the web module, which
+  // has no CHOLMOD: there the integrator's own loop runs.
+  bool local_global_iterate(World& world, LocalGlobalSystem& system, int iterations) override;
+#endif
 
   // Which of the world's force effects it summed itself in its last evaluation ("gravity+
   // springs+ buoyancy-"), for tests and for `clothlab bench`.
@@ -138,6 +148,8 @@ class FastEngine final : public Backend {
   Copies copies_;
   SoA3 xpbd_x_, xpbd_old_;  // x and x_old in the fast layout, for XPBD's projections
   std::shared_ptr<ImplicitSolver> implicit_;  // implicit Euler's arrays (implicit.cpp)
+  // The local/global solver's factor and buffers (local_global.cpp), made on its first step.
+  std::shared_ptr<LocalGlobalRoom> local_global_;
 };
 
 // A world's fast engine: what a scene installs as World::backend.

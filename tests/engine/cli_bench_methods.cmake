@@ -70,14 +70,16 @@ run_bench("bench methods --speed" bench methods --quick --no-plot --min-seconds 
 file(STRINGS ${WORK}/speed/speed.csv speed)
 list(LENGTH speed count)
 list(GET speed 0 header)
-# Four measures, readable and engine room, on 1 and 2 threads: sixteen rows.
-if(NOT count EQUAL 17 OR NOT header STREQUAL "grid,springs,measure,ns_per_spring,threads")
-  message(FATAL_ERROR "speed.csv is not a header and sixteen rows:\n${speed}")
+# Five measures, readable and engine room, on 1 and 2 threads: twenty rows.
+if(NOT count EQUAL 21 OR NOT header STREQUAL "grid,springs,measure,ns_per_spring,threads")
+  message(FATAL_ERROR "speed.csv is not a header and twenty rows:\n${speed}")
 endif()
 foreach(row "16,[0-9]+,xpbd-iteration,[-0-9.e]+,1" "16,[0-9]+,xpbd-iteration-readable,[-0-9.e]+,2"
         "16,[0-9]+,symplectic-euler-step,[0-9.e-]+,2"
         "16,[0-9]+,implicit-euler-cg-iteration,[0-9.e-]+,1"
-        "16,[0-9]+,implicit-euler-cg-iteration-readable,[0-9.e-]+,2")
+        "16,[0-9]+,implicit-euler-cg-iteration-readable,[0-9.e-]+,2"
+        "16,[0-9]+,local-global-iteration,[-0-9.e]+,2"
+        "16,[0-9]+,local-global-iteration-readable,[-0-9.e]+,1")
   set(found ${speed})
   list(FILTER found INCLUDE REGEX "^${row}$")
   if(NOT found)

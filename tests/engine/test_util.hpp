@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "clothlab/bodies/cloth.hpp"
+#include "clothlab/core/step_timer.hpp"
 #include "clothlab/core/world.hpp"
 #include "clothlab/forces/gravity.hpp"
 #include "clothlab/forces/spring_damper.hpp"
@@ -166,22 +167,37 @@ duration = 2
 )" + integrator_keys;
 }
 
+// The scene `text` stepped `steps` times with the fast path and without it, side by side, and
+// what the fast path's backend took of the steps (times).
+struct FastAndReadable {
+  clothlab::Scene fast, readable;
+  clothlab::StepTimer timer;  // on the fast path's world, as --stats times it
+  clothlab::StepTimes times;  // what it measured
+};
+inline std::unique_ptr<FastAndReadable> step_fast_and_readable(const std::string& text, int steps) {
+  auto both = std::make_unique<FastAndReadable>(
+      FastAndReadable{clothlab::parse_scene(text, "fast.toml"),
+                      clothlab::parse_scene(text, "readable.toml"),
+                      {},
+                      {}});
+  both->readable.world.backend.reset();
+  REQUIRE(both->fast.world.backend != nullptr);
+  both->timer.attach(both->fast.world);
+  for (int s = 0; s < steps; ++s) {
+    both->fast.world.step(both->fast.dt);
+    both->readable.world.step(both->readable.dt);
+  }
+  both->times = both->timer.times;
+  return both;
+}
+
 // The scene `text` stepped 200 times with and without the fast path: the same state, bit for
 // bit, and the fast path took no step and no force sum (it takes whole steps for the Euler
 // methods only).
 inline void check_fast_path_declines(const std::string& text) {
-  clothlab::Scene fast = clothlab::parse_scene(text, "fast.toml");
-  clothlab::Scene readable = clothlab::parse_scene(text, "readable.toml");
-  readable.world.backend.reset();
-  REQUIRE(fast.world.backend != nullptr);
-  clothlab::StepTimer timer;
-  timer.attach(fast.world);
-  const clothlab::StepTimes& times = timer.times;
-  for (int s = 0; s < 200; ++s) {
-    fast.world.step(fast.dt);
-    readable.world.step(readable.dt);
-  }
-  CHECK(times.backend_steps == 0.0);
+  const auto both = step_fast_and_readable(text, 200);
+  const clothlab::Scene &fast = both->fast, &readable = both->readable;
+  CHECK(both->times.backend_steps == 0.0);
   CHECK(fast.world.backend_evaluations == 0);
   const bool same_x = fast.world.particles.x == readable.world.particles.x;
   const bool same_v = fast.world.particles.v == readable.world.particles.v;

@@ -5,7 +5,9 @@
 
 #include <algorithm>
 #include <atomic>
+#include <cmath>
 #include <functional>
+#include <limits>
 #include <memory>
 #include <numeric>
 #include <random>
@@ -21,6 +23,7 @@
 #include "clothlab/forces/aerodynamics.hpp"
 #include "clothlab/forces/bending.hpp"
 #include "clothlab/forces/spring_damper.hpp"
+#include "clothlab/integrators/local_global.hpp"
 #include "clothlab/integrators/xpbd.hpp"
 #include "fast/aerodynamics.hpp"
 #include "fast/engine.hpp"
@@ -921,4 +924,76 @@ TEST_CASE("fast path: XPBD with tearing and plasticity recolours and matches the
         spring_effect(readable.world, "springs")->springs().l0());
   const auto& xpbd = dynamic_cast<const clothlab::Xpbd&>(*threaded.world.integrator);
   CHECK(xpbd.backend_substeps == 400 * 2);
+}
+
+// The local/global solver's engine room: the local steps and right-hand sides are the readable
+// loop's operations, so the first local step gives the same d bit for bit; the solve is CHOLMOD's
+// factor of the same matrix A where the readable loop has Eigen's, so the positions agree
+// within rounding. The bound: each is a backward-stable Cholesky solve, whose relative error is
+// at most kappa(A) gamma_{3n+1} (Higham, "Accuracy and Stability of Numerical Algorithms",
+// theorem 10.4, n unknowns, gamma_m = m eps / (1 - m eps)), and kappa(A) is at most the largest
+// Gershgorin row bound over the smallest eigenvalue, itself at least the smallest mass (A = M +
+// a positive semi-definite part). Two such solves differ by at most twice that. An iteration
+// does not amplify a difference in x (the local step is a projection and the global step's
+// A^-1 h^2 L has norm below 1 for springs near their rest length), and a step carries it over
+// through v = (x - x_n) / h and back by h v, so after `steps` steps of `iterations` the
+// positions differ by at most steps * iterations * 2 kappa gamma_{3n+1} * max |x|.
+TEST_CASE(
+    "fast path: local/global in the engine room: the readable d bit for bit, x within the "
+    "solves' rounding, 1-4 threads") {
+  std::string text = cloth("", "local-global", 30, 28);
+  text.replace(text.find("dt = 0.0005"), 11, "dt = 0.004\niterations = 10");
+  const int steps = 60;
+  const clothlab::Scene readable = run(text, false, 1, steps);
+  const auto& readable_lg = dynamic_cast<const clothlab::LocalGlobal&>(*readable.world.integrator);
+  CHECK(readable_lg.backend_steps == 0);
+  const Matrix3X& x_read = readable.world.particles.x;
+  CHECK((x_read - clothlab::parse_scene(text, "t").world.particles.x).cwiseAbs().maxCoeff() >
+        1e-2);  // the cloth moved
+
+  // The bound above, from the system's matrix.
+  const clothlab::LocalGlobalSystem& system = readable_lg.system();
+  const Eigen::SparseMatrix<double>& a = system.a;
+  double gershgorin = 0.0;
+  Eigen::VectorXd row_sum = Eigen::VectorXd::Zero(a.rows());
+  for (Index c = 0; c < a.outerSize(); ++c) {
+    for (Eigen::SparseMatrix<double>::InnerIterator e(a, c); e; ++e)
+      row_sum[e.row()] += std::abs(e.value());
+  }
+  gershgorin = row_sum.maxCoeff();
+  const double kappa = gershgorin / readable.world.particles.m.minCoeff();
+  const double eps = std::numeric_limits<double>::epsilon();
+  const double m3 = (3.0 * static_cast<double>(a.rows()) + 1.0) * eps;
+  const double gamma = m3 / (1.0 - m3);
+  const int iterations = readable_lg.iterations;
+  const double bound = steps * iterations * 2.0 * kappa * gamma * x_read.cwiseAbs().maxCoeff();
+  MESSAGE("kappa(A) <= " << kappa << ", bound " << bound << " m");
+  REQUIRE(bound < 1e-6);  // a bound that can tell a wrong step from rounding
+
+  Matrix3X x_one_thread;
+  for (int threads = 1; threads <= 4; ++threads) {
+    CAPTURE(threads);
+    const clothlab::Scene fast = run(text, true, threads, steps);
+    const auto& lg = dynamic_cast<const clothlab::LocalGlobal&>(*fast.world.integrator);
+    CHECK(lg.backend_steps == steps);  // the engine room took every step: no silent fallback
+    const double difference = (fast.world.particles.x - x_read).cwiseAbs().maxCoeff();
+    MESSAGE(threads << " threads: positions differ by " << difference << " m at most");
+    CHECK(difference <= bound);
+    // The threads split the local steps and the rows, never a sum: the same bits on any number.
+    if (threads == 1) x_one_thread = fast.world.particles.x;
+    CHECK(identical(fast.world.particles.x, x_one_thread));
+  }
+
+  // One step of one iteration: the local step read the same x, so d is the same, bit for bit.
+  std::string one = text;
+  one.replace(one.find("iterations = 10"), 15, "iterations = 1");
+  const clothlab::Scene r1 = run(one, false, 1, 1);
+  for (int threads = 1; threads <= 4; ++threads) {
+    CAPTURE(threads);
+    const clothlab::Scene f1 = run(one, true, threads, 1);
+    const auto& lg_r = dynamic_cast<const clothlab::LocalGlobal&>(*r1.world.integrator);
+    const auto& lg_f = dynamic_cast<const clothlab::LocalGlobal&>(*f1.world.integrator);
+    CHECK(lg_f.backend_steps == 1);
+    CHECK(identical(lg_f.system().d, lg_r.system().d));
+  }
 }

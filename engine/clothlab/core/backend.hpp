@@ -20,6 +20,7 @@ namespace clothlab {
 class World;
 struct XpbdConstraints;
 struct LinearSolveStats;
+struct LocalGlobalSystem;
 
 // What a backend took of a step (Backend::step).
 struct BackendStep {
@@ -65,6 +66,17 @@ class Backend {
   virtual bool implicit_euler_step(World& /*world*/, double /*dt*/, double /*tolerance*/,
                                    int /*max_iterations*/, VectorX& /*dv*/,
                                    LinearSolveStats& /*stats*/) {
+    return false;
+  }
+
+  // The local/global solver's iterations of one step (integrators/local_global.hpp): each time,
+  // every spring's d from world.particles.x (the local step, into system.d), then the global
+  // step's solve of system.a x = b_fixed + J d, written to the free particles' x. The same
+  // local steps and right-hand sides as LocalGlobal::advance's own loop; the solve may be
+  // another factorisation of the same matrix (the result within the tolerance tests/fast/
+  // derives). False: declined, nothing changed.
+  virtual bool local_global_iterate(World& /*world*/, LocalGlobalSystem& /*system*/,
+                                    int /*iterations*/) {
     return false;
   }
 };

@@ -36,6 +36,13 @@ class TimedBackend final : public Backend {
     return inner_->xpbd_project(world, constraints, x_old, h, iterations, keep_lambda, lambda);
   }
 
+  bool local_global_iterate(World& world, LocalGlobalSystem& system, int iterations) override {
+    StepTimer::Lap lap(&timer_.times.backend_steps);
+    const bool taken = inner_->local_global_iterate(world, system, iterations);
+    if (!taken) lap.discard();
+    return taken;
+  }
+
   bool implicit_euler_step(World& world, double dt, double tolerance, int max_iterations,
                            VectorX& dv, LinearSolveStats& stats) override {
     StepTimer::Lap lap(&timer_.times.backend_steps);

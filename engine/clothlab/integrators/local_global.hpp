@@ -51,6 +51,22 @@ class SpringSet;
 // last local step), never NaN.
 Vec3 local_step_projection(const Vec3& x_i, const Vec3& x_j, double l0, const Vec3& d_previous);
 
+// The global step's system as LocalGlobal last built it, for the world's backend
+// (core/backend.hpp): the matrix, the unknowns, and the springs in one list (the order of the
+// spring families, then of each set).
+struct LocalGlobalSystem {
+  Eigen::SparseMatrix<double> a;  // M + h C + h^2 L on the free rows (lower and upper halves)
+  long version = 0;               // moves each time `a` is built again
+  std::vector<Index> unknown;     // particle -> row of the system, -1: pinned
+  std::vector<Index> particle;    // row of the system -> particle
+  std::vector<Index> i, j;        // each spring's ends
+  std::vector<double> l0;         // [m] each spring's rest length, read again each step
+  std::vector<double> push;       // [1/s^2 ...] h^2 ks of each spring, as the readable loop has it
+  Matrix3X d;                     // [m] each spring's d (kept between steps)
+  // [..] The right-hand side's part no iteration changes: one row per unknown, one column per axis.
+  Eigen::Matrix<double, Eigen::Dynamic, 3> b_fixed;
+};
+
 // method = "local-global": implicit Euler by Liu et al.'s local/global iterations.
 class LocalGlobal final : public Integrator {
  public:
@@ -65,6 +81,10 @@ class LocalGlobal final : public Integrator {
   // How often the matrix was factored: once per scene and dt, again when dt, a stiffness, a
   // damper, a mass, a pin or the spring set changes (tearing), never for a rest length.
   long factorizations() const { return factorizations_; }
+  // The global step's system as last built (for tests).
+  const LocalGlobalSystem& system() const { return system_; }
+  // Steps whose iterations the world's backend took (Backend::local_global_iterate).
+  long backend_steps = 0;
 
  private:
   // What the factored matrix was built from; a step that finds any of it changed refactors.
@@ -76,15 +96,13 @@ class LocalGlobal final : public Integrator {
   std::vector<const SpringSet*> families_;  // "springs", "bending": every spring is in it
   std::vector<unsigned long> versions_;     // each family's version() when factored
   VectorX m_;                               // [kg] the masses when factored
-  std::vector<Index> unknown_;              // particle -> row of the system, -1: pinned
-  std::vector<Index> particle_;             // row of the system -> particle
+  LocalGlobalSystem system_;                // the matrix, the unknowns, the springs, d and b_fixed
   Eigen::SimplicialLLT<Eigen::SparseMatrix<double>> llt_;  // M + h C + h^2 L on the free rows
-  Matrix3X d_;      // [m] every spring's d, in the order of families_ (kept for coincident ends)
   Matrix3X f_ext_;  // [N] the external forces at the step's start
   Matrix3X x_n_;    // [m] the positions the step starts from
-  // The global step's right-hand side (the part fixed for the step, then the whole) and its
-  // solution: one row per unknown particle, one column per axis.
-  Eigen::Matrix<double, Eigen::Dynamic, 3> b_fixed_, b_, x_;
+  // The global step's right-hand side and its solution: one row per unknown particle, one column
+  // per axis.
+  Eigen::Matrix<double, Eigen::Dynamic, 3> b_, x_;
 };
 
 }  // namespace clothlab
