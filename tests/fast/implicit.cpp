@@ -215,7 +215,7 @@ TEST_CASE("implicit Euler in the engine room: every step taken, the same bits on
     for (int s = 0; s < steps; ++s)
       scene.world.step(scene.dt);
     const clothlab::ImplicitEuler& implicit = implicit_of(scene.world);
-    CHECK(implicit.backend_steps == steps);  // no silent fallback
+    CHECK(implicit.backend_steps == steps);                    // no silent fallback
     if (threads == 3) CHECK(timer.times.backend_steps > 0.0);  // and timed as the backend's
     CHECK(implicit.stats().solves == steps);
     CHECK(implicit.stats().unconverged == 0);
