@@ -39,6 +39,7 @@
 #include "clothlab/forces/spring_damper.hpp"
 #include "clothlab/integrators/implicit_euler.hpp"
 #include "fast/engine.hpp"
+#include "fast/incidence.hpp"
 
 namespace clothlab::fast {
 
@@ -109,19 +110,8 @@ struct ImplicitSolver {
         sj.push_back(set->j(k));
       }
     }
-    start.assign(static_cast<size_t>(n) + 1, 0);
-    for (size_t k = 0; k < springs(); ++k) {
-      ++start[static_cast<size_t>(si[k]) + 1];
-      ++start[static_cast<size_t>(sj[k]) + 1];
-    }
-    for (Index i = 0; i < n; ++i)
-      start[static_cast<size_t>(i) + 1] += start[static_cast<size_t>(i)];
-    ends.assign(2 * springs(), 0);
-    std::vector<Index> next(start.begin(), start.end() - 1);
-    for (size_t k = 0; k < springs(); ++k) {
-      ends[static_cast<size_t>(next[static_cast<size_t>(si[k])]++)] = static_cast<Index>(2 * k);
-      ends[static_cast<size_t>(next[static_cast<size_t>(sj[k])]++)] = static_cast<Index>(2 * k + 1);
-    }
+    group_ends_by_row(
+        si, sj, n, [](Index particle) { return particle; }, start, ends);
     for (auto& column : block)
       column.assign(springs(), 0.0);
     u.assign(springs());

@@ -23,6 +23,7 @@
 #include "clothlab/core/world.hpp"
 #include "clothlab/integrators/local_global.hpp"
 #include "fast/engine.hpp"
+#include "fast/incidence.hpp"
 #include "fast/vectorise.hpp"
 
 namespace clothlab::fast {
@@ -97,27 +98,10 @@ void prepare_room(LocalGlobalRoom& room, const LocalGlobalSystem& system) {
   room.llt.compute(system.a);
   if (room.llt.info() != Eigen::Success)
     throw std::runtime_error("local-global: CHOLMOD could not factor M + h C + h^2 L");
-  const size_t ns = system.i.size();
-  room.start.assign(static_cast<size_t>(rows) + 1, 0);
-  for (size_t s = 0; s < ns; ++s) {
-    for (const Index end : {system.i[s], system.j[s]}) {
-      const Index r = system.unknown[static_cast<size_t>(end)];
-      if (r >= 0) ++room.start[static_cast<size_t>(r) + 1];
-    }
-  }
-  for (size_t r = 0; r < static_cast<size_t>(rows); ++r)
-    room.start[r + 1] += room.start[r];
-  room.incident.assign(static_cast<size_t>(room.start.back()), 0);
-  std::vector<Index> next(room.start.begin(), room.start.end() - 1);
-  for (size_t s = 0; s < ns; ++s) {
-    const Index ends[2] = {system.i[s], system.j[s]};
-    for (Index side = 0; side < 2; ++side) {
-      const Index r = system.unknown[static_cast<size_t>(ends[side])];
-      if (r >= 0)
-        room.incident[static_cast<size_t>(next[static_cast<size_t>(r)]++)] =
-            2 * static_cast<Index>(s) + side;
-    }
-  }
+  group_ends_by_row(
+      system.i, system.j, rows,
+      [&](Index particle) { return system.unknown[static_cast<size_t>(particle)]; }, room.start,
+      room.incident);
   room.system = &system;
   room.version = system.version;
   room.rows = rows;
