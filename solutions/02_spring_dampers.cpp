@@ -27,14 +27,12 @@ Vec3 spring_damper_force(const Vec3& r1, const Vec3& r2, const Vec3& v1, const V
   // BEGIN ex02.1: see lessons/02-spring-dampers/README.md
   const Vec3 e_star = r2 - r1;  // from particle 1 to particle 2 [m]
   const double l = e_star.norm();
-  if (l == 0.0) return Vec3::Zero();  // coincident particles: no direction to act along
-  // The lecture's e = e* / l, e . v1 - e . v2 and f_sd e, with 1 / l computed once. The square
-  // root and the division are the slowest steps here; the dot product with e* needs neither, so
-  // the processor works on it while they finish (the lesson's "Going further" times both forms).
-  const double inv_l = 1.0 / l;
-  const double v1_minus_v2 = e_star.dot(v1 - v2) * inv_l;  // v1 - v2 along e [m/s]
-  const double f_sd = -ks * (l0 - l) - kd * v1_minus_v2;   // 1D spring + damper force [N]
-  return (f_sd * inv_l) * e_star;                          // f_sd e [N]
+  if (l == 0.0) return Vec3::Zero();    // coincident particles: no direction to act along
+  const Vec3 e = e_star * (1.0 / l);    // unit vector from 1 to 2: e* / l, with one division
+  const double v1_along_e = e.dot(v1);  // [m/s]
+  const double v2_along_e = e.dot(v2);  // [m/s]
+  const double f_sd = -ks * (l0 - l) - kd * (v1_along_e - v2_along_e);  // spring + damper [N]
+  return f_sd * e;                                                      // f1 = f_sd e [N]
   // END ex02.1
 }
 
