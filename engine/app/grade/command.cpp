@@ -22,6 +22,7 @@
 #include <cstdlib>
 #include <exception>
 #include <filesystem>
+#include <fstream>
 #include <iostream>
 #include <memory>
 #include <numeric>
@@ -60,6 +61,7 @@ struct Options {
   bool hidden = false;           // also the hidden cases of tests/grade-hidden/ (instructors)
   std::string exercises;         // hidden: the student's exercise files; default exercises/
   int rounds = 0;                // watch: stop after this many gradings (0: never; for tests)
+  std::string web_build;         // watch, hidden: rebuild the student pages of this web build
 };
 
 // A program of the build folder: the grading binary and the kernels programs are built next to
@@ -353,35 +355,57 @@ Snapshot exercise_files(const fs::path& dir) {
   return files;
 }
 
+// A value of a CMake cache (a line KEY:TYPE=VALUE), or "" where there is none.
+std::string cache_value(const fs::path& cache, const std::string& key) {
+  std::ifstream in(cache);
+  for (std::string line; std::getline(in, line);) {
+    const size_t equals = line.find('=');
+    if (line.starts_with(key + ":") && equals != std::string::npos) return line.substr(equals + 1);
+  }
+  return "";
+}
+
 // The student's live pages (engine/web/), rebuilt on each save where the build can make them
-// (it found emscripten when it was configured), and only for the exercises those pages are built
-// from: the course's exercises/, not a folder given with --exercises. Says where they are, or
-// why they could not be rebuilt.
+// (it found emscripten when it was configured): the pages of the course's exercises/, by the
+// build's `web-student` target; not those of a folder given with --exercises, unless --web-build
+// names a web build of the student pages alone made for that folder (ENGINE_FROM in
+// engine/web/CMakeLists.txt; the test of watch's pages makes one). Says where they are, or why
+// they could not be rebuilt.
 void rebuild_student_pages(const Options& o) {
 #if CLOTHLAB_WEB_STUDENT
-  if (!o.exercises.empty()) return;
   const std::string build = build_dir();
-  if (!fs::exists(fs::path(build) / "web" / "CMakeCache.txt")) {
-    // Never built here: the first build takes many minutes, too long to start on a save.
-    fmt::print(
-        "\n(your live pages are not built: `cmake --build {} --target web-student` builds "
-        "them once, and watch then rebuilds them each time you save)\n",
-        relative_path(build));
+  std::string dir = build, target = "web-student";
+  fs::path web = fs::path(build) / "web";
+  if (!o.web_build.empty()) {
+    dir = o.web_build;
+    web = o.web_build;
+    target = "pages-student";
+  } else if (!o.exercises.empty()) {
     return;
   }
-  fmt::print("\nrebuilding your live pages (cmake --build {} --target web-student) ...\n",
-             relative_path(build));
+  if (!fs::exists(web / "CMakeCache.txt")) {
+    // Never built here: the first build takes many minutes, too long to start on a save.
+    fmt::print(
+        "\n(your live pages are not built: `cmake --build {} --target {}` builds them once, and "
+        "watch then rebuilds them each time you save)\n",
+        relative_path(dir), target);
+    return;
+  }
+  std::string pages = cache_value(web / "CMakeCache.txt", "PAGES_DIR");
+  if (pages.empty()) pages = (fs::path(build) / "pages").string();
+  fmt::print("\nrebuilding your live pages (cmake --build {} --target {}) ...\n",
+             relative_path(dir), target);
   std::fflush(stdout);
   const Clock::time_point start = Clock::now();
   const ProcessResult r =
-      run_process({CLOTHLAB_CMAKE_COMMAND, "--build", build, "--target", "web-student"}, 900);
+      run_process({CLOTHLAB_CMAKE_COMMAND, "--build", dir, "--target", target}, 900);
   const double seconds = std::chrono::duration<double>(Clock::now() - start).count();
   if (r.interrupted) return;
   if (r.exit_code == 0 && r.signal == 0 && !r.timed_out) {
     fmt::print(
-        "your live pages, rebuilt in {:.1f} s: open {}/pages/NN-name-student.html in a "
+        "your live pages, rebuilt in {:.1f} s: open {}/NN-name-student.html in a "
         "browser (reload it if it is open)\n",
-        seconds, relative_path(build));
+        seconds, relative_path(pages));
     return;
   }
   // The build's last lines: the compiler's error, or what else stopped it.
@@ -459,6 +483,9 @@ void add_watch_command(CLI::App& app) {
   cmd->add_option("--exercises", o->exercises, "The folder of exercise files")->group("");
   cmd->add_option("--scratch", o->scratch, "Where to build them")->group("");
   cmd->add_option("--rounds", o->rounds, "Stop after this many gradings")->group("");
+  cmd->add_option("--web-build", o->web_build,
+                  "Rebuild the student pages of this web build (one made for --exercises)")
+      ->group("");
   cmd->callback([o] { watch(*o); });
 }
 

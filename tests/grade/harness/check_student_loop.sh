@@ -17,6 +17,7 @@ die() {
   echo "check_student_loop: $*" >&2
   exit 1
 }
+source "$(dirname "$0")/watch_session.sh"
 grade() { NO_COLOR=1 "$clothlab" grade --exercises "$work/exercises" --scratch "$work/scratch" "$@"; }
 ex01=$work/exercises/01_particles_and_euler.cpp
 cp "$source_dir/solutions/01_particles_and_euler.cpp" "$ex01"
@@ -69,27 +70,9 @@ log=$work/watch.log
 NO_COLOR=1 "$clothlab" watch ex01.1 --exercises "$work/exercises" --scratch "$work/scratch" \
   --rounds 2 >"$log" 2>&1 &
 watcher=$!
-for _ in $(seq 600); do
-  grep -q 'waiting for a change' "$log" && break
-  kill -0 "$watcher" 2>/dev/null || break
-  sleep 0.2
-done
-grep -q 'waiting for a change' "$log" || {
-  cat "$log"
-  die "watch did not wait for a change"
-}
+watch_waits "$log" "$watcher" 120
 sed -i 's/return m \* g$/return m * g;/' "$ex01"
-for _ in $(seq 600); do
-  kill -0 "$watcher" 2>/dev/null || break
-  sleep 0.2
-done
-if kill -0 "$watcher" 2>/dev/null; then
-  kill "$watcher"
-  cat "$log"
-  die "watch did not grade again after the file was saved"
-fi
-wait "$watcher" || die "watch exited with $?"
-cat "$log"
+watch_ends "$log" "$watcher" 120 "grade again after the file was saved"
 grep -Eq '^ex01\.1 +0 / 2 +0 / 2 +not compiled' "$log" || die "watch's first grading is not the broken file's"
 grep -q '(01_particles_and_euler.cpp changed)' "$log" || die "watch does not say which file changed"
 grep -Eq '^ex01\.1 +2 / 2 +2 / 2 +done' "$log" || die "watch's second grading is not the mended file's"
