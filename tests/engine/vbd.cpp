@@ -475,3 +475,37 @@ TEST_CASE("vbd colouring: valid with bending springs, on a lattice and on random
     CHECK(static_cast<size_t>(any.colour[at]) <= any.start[at + 1] - any.start[at]);
   }
 }
+
+TEST_CASE("vbd: a cloth scrambled at random recovers its shape") {
+  // The paper's demonstration, on a mass-spring cloth: a 10 x 10 cloth (5 cm apart, 1 g a particle,
+  // ks = 100 N/m, kd = 0.01 N s/m, no gravity, no pins) with every particle thrown to a random
+  // point of a 10 cm box. Nothing but the springs acts: VBD must pull it back to a sheet whose
+  // springs are near their rest lengths.
+  clothlab::Scene scene = clothlab::parse_scene(
+      "[cloth]\nrows = 10\ncols = 10\nspacing = 0.05\nmass = 0.1\npins = \"none\"\n"
+      "[springs]\nks = 100\nkd = 0.01\n[integrator]\nmethod = \"vbd\"\niterations = 10\n"
+      "dt = 0.016666666666666666\nduration = 5\n",
+      "scrambled.toml");
+  clothlab::Particles& p = scene.world.particles;
+  unsigned state = 2024;
+  for (Index i = 0; i < p.size(); ++i) {
+    for (int a = 0; a < 3; ++a) {
+      state = state * 1103515245u + 12345u;
+      p.x(a, i) = 0.1 * static_cast<double>((state >> 8) % 10000) / 10000.0;
+    }
+  }
+  const clothlab::SpringSet& s = test::springs_of(scene.world);
+  const auto worst_strain = [&] {
+    double worst = 0.0;
+    for (size_t k = 0; k < s.size(); ++k)
+      worst = std::max(worst, std::abs((p.x.col(s.i(k)) - p.x.col(s.j(k))).norm() / s.l0(k) - 1.0));
+    return worst;
+  };
+  const double before = worst_strain();
+  REQUIRE(before > 1.0);  // some spring at more than twice its rest length, or squeezed to 0
+  test::run_to_end(scene);
+  // Measured: the worst spring 171 % off its rest length at the start, 0.50 % after 5 s.
+  const double after = worst_strain();
+  MESSAGE("worst strain " << before << " -> " << after);
+  CHECK(after < 0.01);
+}

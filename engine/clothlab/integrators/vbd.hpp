@@ -30,6 +30,14 @@
 // y, the minimiser of G without the springs: a cloth at rest or in free fall starts where it
 // ends, and one iteration already holds the springs implicitly.
 //
+// Stopped early, the step is not implicit Euler's. A sweep carries a pin's pull only a vertex or
+// two further, so on a large cloth of light particles a few sweeps leave the cloth far from the
+// pins falling as if they were not there, and the springs between stretch: the cloth acts much
+// softer than its ks. Measured with `clothlab run` on a 64 x 64 cloth (2 cm apart, 1 kg in all,
+// ks = 1000 N/m, kd = 0.01 N s/m, gravity, top corners pinned) at 1/60 s for 20 steps: its total
+// energy went from -6.17 J to 281 J with 1 iteration, 179 J with 10 and 51 J with 100, where
+// local-global (10 iterations) ended at -6.23 J. More iterations or smaller steps bring it back.
+//
 // The colouring. Within a sweep each vertex step sees the positions its neighbours have just
 // been given (Gauss-Seidel), so the order is part of the method. The vertices are coloured so
 // that no two joined by a spring share a colour (vbd_colouring, greedy), and swept colour by
