@@ -23,6 +23,8 @@ set(CLOTHLAB_PHYSICS_SOURCES
   clothlab/integrators/implicit_euler.cpp
   clothlab/integrators/xpbd.cpp
   clothlab/integrators/local_global.cpp
+  clothlab/integrators/vbd_vertex.cpp
+  clothlab/integrators/vbd.cpp
   clothlab/bodies/cloth.cpp
   clothlab/bodies/rope.cpp
   clothlab/bodies/solid.cpp

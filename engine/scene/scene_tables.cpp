@@ -24,6 +24,7 @@
 #include "clothlab/integrators/implicit_euler.hpp"
 #include "clothlab/integrators/local_global.hpp"
 #include "clothlab/integrators/methods.hpp"
+#include "clothlab/integrators/vbd.hpp"
 #include "clothlab/integrators/xpbd.hpp"
 
 namespace clothlab {
@@ -874,17 +875,17 @@ void read_integrator(SceneTable& t, Scene& scene) {
   const std::string method = t.choice("method", names, "symplectic-euler");
   scene.world.integrator = make_integrator(method);
   // The substeps and projections of the position-based method, the iterations of the
-  // local/global one; the force-based ones have none.
+  // local/global solver and of vertex block descent; the force-based ones have none.
   if (method != "xpbd" && t.has("substeps")) {
     t.fail("substeps", fmt::format("substeps sets the position-based method = \"xpbd\" (lesson "
                                    "12), but method is \"{}\"; expected no substeps here",
                                    method));
   }
-  if (method != "xpbd" && method != "local-global" && t.has("iterations")) {
+  if (method != "xpbd" && method != "local-global" && method != "vbd" && t.has("iterations")) {
     t.fail("iterations",
-           fmt::format("iterations sets the iterations of method = \"xpbd\" (lesson 12) or "
-                       "\"local-global\" (lesson 13), but method is \"{}\"; expected no "
-                       "iterations here",
+           fmt::format("iterations sets the iterations of method = \"xpbd\" (lesson 12), "
+                       "\"local-global\" (lesson 13) or \"vbd\" (lesson 14), but method is "
+                       "\"{}\"; expected no iterations here",
                        method));
   }
   if (auto* xpbd = dynamic_cast<Xpbd*>(scene.world.integrator.get())) {
@@ -895,6 +896,8 @@ void read_integrator(SceneTable& t, Scene& scene) {
     local_global->iterations =
         static_cast<int>(t.integer("iterations", 1, 10'000, local_global->iterations));
   }
+  if (auto* vbd = dynamic_cast<Vbd*>(scene.world.integrator.get()))
+    vbd->iterations = static_cast<int>(t.integer("iterations", 1, 10'000, vbd->iterations));
   // The linear solver of the implicit method; another method has none to tune.
   for (const char* key : {"tolerance", "max_iterations"}) {
     if (method != "implicit-euler" && t.has(key)) {

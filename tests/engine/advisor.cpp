@@ -554,6 +554,11 @@ TEST_CASE(
       cost_scene(100, "method = \"local-global\"\niterations = 50\n" + plain), false, false, false);
   REQUIRE(warnings.size() == 1);
   CHECK(warnings[0].find("the local/global solver takes 50 iterations a step") == 0);
+  warnings = clothlab::run_cost_warnings(
+      cost_scene(100, "method = \"vbd\"\niterations = 50\n" + plain), false, false, false);
+  REQUIRE(warnings.size() == 1);
+  CHECK(warnings[0].find("vertex block descent takes 50 iterations a step over 39402 springs") ==
+        0);
   warnings = clothlab::run_cost_warnings(cost_scene(100, "method = \"implicit-euler\"\n" + plain),
                                          false, false, false);
   REQUIRE(warnings.size() == 1);

@@ -59,12 +59,13 @@ std::string blow_up_message(clothlab::World& world) {
 
 }  // namespace
 
-TEST_CASE("guard: its advice is true for the method: XPBD and local/global have no dt limit") {
-  // Blamed on dt and stability limits, a blow-up under XPBD or the local/global solver sent a
-  // user to shrink a dt that was not the cause: neither has a time-step limit on its springs.
+TEST_CASE("guard: its advice is true for the method: XPBD, local/global and VBD have no dt limit") {
+  // Blamed on dt and stability limits, a blow-up under XPBD, the local/global solver or vertex
+  // block descent sent a user to shrink a dt that was not the cause: none has a time-step limit
+  // on its springs.
   const std::string dt_blamed = "A time step too large for the stiffness is the usual cause";
   const std::string limit_blamed = "dt is above its stability limit";
-  for (const char* method : {"xpbd", "local-global", "symplectic-euler"}) {
+  for (const char* method : {"xpbd", "local-global", "vbd", "symplectic-euler"}) {
     CAPTURE(method);
     const bool limited = std::string(method) == "symplectic-euler";
     const std::string no_limit =

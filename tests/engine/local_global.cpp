@@ -5,7 +5,6 @@
 // left out).
 #include <doctest/doctest.h>
 
-#include <Eigen/Dense>
 #include <cmath>
 #include <memory>
 #include <string>
@@ -15,6 +14,7 @@
 #include "clothlab/forces/gravity.hpp"
 #include "clothlab/integrators/local_global.hpp"
 #include "clothlab/integrators/methods.hpp"
+#include "implicit_solvers.hpp"
 #include "scene/scene.hpp"
 #include "test_util.hpp"
 
@@ -25,8 +25,6 @@ using clothlab::Vec3;
 using clothlab::World;
 
 namespace {
-
-constexpr double kG = 9.8;  // [m/s^2]
 
 LocalGlobal& use_local_global(World& world, int iterations) {
   auto integrator = std::make_unique<LocalGlobal>();
@@ -41,148 +39,15 @@ void run(World& world, double dt, long steps) {
     world.step(dt);
 }
 
-double total_energy(const World& world) {
-  return world.kinetic_energy() + world.potential_energy();
-}
-
-// A 3 x 3 patch of particles 1 m apart in the x-y plane joined by its row, column and diagonal
-// springs (ks [N/m], kd [N s/m], rest length 1 m or sqrt 2), corner 0 pinned, the others pulled
-// out of place and moving: a step of it is far from linear.
-World patch(double ks, double kd) {
-  World world;
-  for (int r = 0; r < 3; ++r) {
-    for (int c = 0; c < 3; ++c) {
-      const double wobble = 0.1 * std::sin(3.0 * r + 5.0 * c);
-      world.particles.add(Vec3(c + 0.4 * wobble, -r - wobble, 0.7 * wobble),
-                          Vec3(wobble, 2.0 * wobble, -wobble), 0.5 + 0.1 * (r + c));
-    }
-  }
-  clothlab::pin(world.particles, 0);
-  world.particles.v.col(0).setZero();
-  clothlab::SpringSet springs;
-  const auto at = [](int r, int c) { return static_cast<Index>(3 * r + c); };
-  for (int r = 0; r < 3; ++r) {
-    for (int c = 0; c < 3; ++c) {
-      if (c + 1 < 3) springs.add(at(r, c), at(r, c + 1), ks, kd, 1.0);
-      if (r + 1 < 3) springs.add(at(r, c), at(r + 1, c), ks, kd, 1.0);
-      if (r + 1 < 3 && c + 1 < 3) springs.add(at(r, c), at(r + 1, c + 1), ks, kd, std::sqrt(2.0));
-    }
-  }
-  world.force_effects.push_back(
-      std::make_unique<clothlab::SpringDampers>("springs", std::move(springs)));
-  world.force_effects.push_back(std::make_unique<clothlab::UniformGravity>(Vec3(0.0, -kG, 0.0)));
-  return world;
-}
-
-// The exact implicit Euler step of `world` by Newton's method on g, written out here, apart
-// from the engine: the minimiser of
-//   g(x) = 1/(2 h^2) (x - y)^T M (x - y) + sum ks/2 (|x_i - x_j| - l0)^2
-//          + 1/(2 h) sum kd |(x_i - x_j) - (x_i,n - x_j,n)|^2 - f_ext^T x
-// over the free particles (the pinned ones move by h v), with y = x_n + h v_n and f_ext = m g.
-// The Hessian is the full one, with the compressed spring's negative term across it; each
-// Newton step is halved until g falls, so the iteration cannot run away.
-Matrix3X newton_implicit_euler(const World& world, double h) {
-  const clothlab::Particles& p = world.particles;
-  const clothlab::SpringSet& s = test::springs_of(world);
-  const Index n = p.size();
-  const Matrix3X x_n = p.x;
-  const Matrix3X y = x_n + h * p.v;
-  const auto g = [&](const Matrix3X& x) {
-    double value = 0.0;
-    for (Index i = 0; i < n; ++i) {
-      value += p.m[i] / (2.0 * h * h) * (x.col(i) - y.col(i)).squaredNorm();
-      value -= p.m[i] * Vec3(0.0, -kG, 0.0).dot(x.col(i));
-    }
-    for (size_t k = 0; k < s.size(); ++k) {
-      const Vec3 e = x.col(s.i(k)) - x.col(s.j(k));
-      const Vec3 e_n = x_n.col(s.i(k)) - x_n.col(s.j(k));
-      value += 0.5 * s.ks(k) * std::pow(e.norm() - s.l0(k), 2);
-      value += s.kd(k) / (2.0 * h) * (e - e_n).squaredNorm();
-    }
-    return value;
-  };
-  Matrix3X x = y;
-  for (Index i = 0; i < n; ++i) {
-    if (p.inv_m[i] != 0.0) x.col(i) += h * h * Vec3(0.0, -kG, 0.0);
-  }
-  const Eigen::Matrix3d I = Eigen::Matrix3d::Identity();
-  for (int it = 0; it < 100; ++it) {
-    Eigen::VectorXd grad = Eigen::VectorXd::Zero(3 * n);
-    Eigen::MatrixXd hess = Eigen::MatrixXd::Zero(3 * n, 3 * n);
-    for (Index i = 0; i < n; ++i) {
-      grad.segment<3>(3 * i) = p.m[i] / (h * h) * (x.col(i) - y.col(i)) - p.m[i] * Vec3(0, -kG, 0);
-      hess.block<3, 3>(3 * i, 3 * i) += p.m[i] / (h * h) * I;
-    }
-    for (size_t k = 0; k < s.size(); ++k) {
-      const Index i = s.i(k), j = s.j(k);
-      const Vec3 e = x.col(i) - x.col(j);
-      const Vec3 e_n = x_n.col(i) - x_n.col(j);
-      const double l = e.norm();
-      const Vec3 u = e / l;
-      const Vec3 gk = s.ks(k) * (l - s.l0(k)) * u + s.kd(k) / h * (e - e_n);
-      const Eigen::Matrix3d hk =
-          s.ks(k) * (u * u.transpose() + (1.0 - s.l0(k) / l) * (I - u * u.transpose())) +
-          s.kd(k) / h * I;
-      grad.segment<3>(3 * i) += gk;
-      grad.segment<3>(3 * j) -= gk;
-      hess.block<3, 3>(3 * i, 3 * i) += hk;
-      hess.block<3, 3>(3 * j, 3 * j) += hk;
-      hess.block<3, 3>(3 * i, 3 * j) -= hk;
-      hess.block<3, 3>(3 * j, 3 * i) -= hk;
-    }
-    // Pinned particles are not unknowns: their rows and columns are the identity.
-    for (Index i = 0; i < n; ++i) {
-      if (p.inv_m[i] != 0.0) continue;
-      grad.segment<3>(3 * i).setZero();
-      hess.middleRows(3 * i, 3).setZero();
-      hess.middleCols(3 * i, 3).setZero();
-      hess.block<3, 3>(3 * i, 3 * i) = I;
-    }
-    if (grad.norm() < 1e-13) break;
-    const Eigen::VectorXd dx = hess.ldlt().solve(-grad);
-    double step = 1.0;
-    const double before = g(x);
-    Matrix3X trial = x + step * Eigen::Map<const Matrix3X>(dx.data(), 3, n);
-    while (g(trial) > before && step > 1e-8) {
-      step *= 0.5;
-      trial = x + step * Eigen::Map<const Matrix3X>(dx.data(), 3, n);
-    }
-    x = trial;
-  }
-  return x;
-}
-
 }  // namespace
 
 TEST_CASE("local-global: a hanging mass settles at the spring's static stretch m g / ks") {
-  // At rest at stretch s, a step finds y = x_n and the global step's row reads
-  // (m + h^2 ks) x = m x_n + h^2 ks (x_anchor + d) + h^2 m g with d = l0 down: x = x_n holds
-  // exactly when ks s = m g, whatever the iterations. With m = 0.1 kg, ks = 100 N/m: 9.8 mm.
-  const double m = 0.1, ks = 100.0, expected = m * kG / ks;
-  const auto hanging = [&](double kd, double stretch) {
-    World world = test::anchored_spring(m, ks, kd, 0.0, 0.0);
-    world.particles.x.col(1) = Vec3(0.0, -1.0 - stretch, 0.0);
-    world.force_effects.push_back(std::make_unique<clothlab::UniformGravity>(Vec3(0, -kG, 0)));
-    return world;
-  };
-  SUBCASE("started at the stretch, it stays there (to rounding)") {
-    World world = hanging(0.0, expected);
-    use_local_global(world, 1);
-    run(world, 1.0 / 60.0, 120);
-    CHECK(std::abs(-1.0 - world.particles.x(1, 1) - expected) <= 1e-12);
-    CHECK(world.particles.v.col(1).norm() <= 1e-9);
-  }
-  SUBCASE("started at its rest length, it swings down and settles there") {
-    // kd = 0.5 N s/m (damping ratio 0.079) and implicit Euler's own damping at h = 1/60 s
-    // (w h = 0.53) take the 9.8 mm swing below 1e-8 m within 10 s; a stiffness off by 1 % would
-    // be 98 um away.
-    for (int iterations : {1, 10}) {
-      CAPTURE(iterations);
-      World world = hanging(0.5, 0.0);
-      use_local_global(world, iterations);
-      run(world, 1.0 / 60.0, 600);
-      CHECK(-1.0 - world.particles.x(1, 1) == doctest::Approx(expected).epsilon(1e-5));
-    }
+  // test::check_hanging_mass. At rest at stretch s, a step finds y = x_n and the global step's
+  // row reads (m + h^2 ks) x = m x_n + h^2 ks (x_anchor + d) + h^2 m g with d = l0 down: x = x_n
+  // holds exactly when ks s = m g, whatever the iterations.
+  for (int iterations : {1, 10}) {
+    CAPTURE(iterations);
+    test::check_hanging_mass([&](World& world) { use_local_global(world, iterations); });
   }
 }
 
@@ -196,12 +61,12 @@ TEST_CASE(
   const double h = 0.02;
   for (double kd : {0.0, 0.5}) {
     CAPTURE(kd);
-    const Matrix3X exact = newton_implicit_euler(patch(200.0, kd), h);
+    const Matrix3X exact = test::newton_implicit_euler(test::patch(200.0, kd), h);
     // Measured: 4.9e-3 m after 1 iteration, 1.1e-7 m after 10, rounding (1e-15 m) after 100.
     double last = 1.0;
     for (int iterations : {1, 3, 10, 100}) {
       CAPTURE(iterations);
-      World world = patch(200.0, kd);
+      World world = test::patch(200.0, kd);
       use_local_global(world, iterations);
       world.step(h);
       const double error = (world.particles.x - exact).cwiseAbs().maxCoeff();
@@ -210,7 +75,7 @@ TEST_CASE(
       last = error;
     }
     CHECK(last < 1e-12);
-    World linearised = patch(200.0, kd);
+    World linearised = test::patch(200.0, kd);
     linearised.integrator = clothlab::make_integrator("implicit-euler");
     linearised.step(h);
     MESSAGE("kd " << kd << ", implicit-euler (one linearised step): error "
@@ -219,25 +84,11 @@ TEST_CASE(
 }
 
 TEST_CASE("local-global: the energy of an undamped spring never grows") {
-  // An undamped spring (ks = 100 N/m, 1 kg, pulled 0.1 m along itself, no gravity) at dt = 10 ms
-  // for 10 s. Converged, a step is implicit Euler, which on a spring along its axis scales the
-  // energy by 1 / (1 + (w h)^2) < 1 (lesson 08): 0.5 J / 1.01^1000 = 2.386e-5 J after 1000
-  // steps (w h = 0.1). Along the spring's own axis d never turns, so one iteration is already
-  // exact. Checked every step, against rounding (1e-12 J).
+  // test::check_spring_energy_decay. Along the spring's own axis d never turns, so one
+  // iteration is already exact.
   for (int iterations : {1, 10}) {
     CAPTURE(iterations);
-    World world = test::anchored_spring(1.0, 100.0, 0.0, 0.1, 0.0);
-    use_local_global(world, iterations);
-    const double e0 = total_energy(world);
-    double e = e0;
-    for (int s = 0; s < 1000; ++s) {
-      world.step(0.01);
-      const double next = total_energy(world);
-      REQUIRE(next <= e + 1e-12);
-      e = next;
-    }
-    MESSAGE(iterations << " iterations: energy " << e0 << " J -> " << e << " J");
-    CHECK(e == doctest::Approx(0.5 * std::pow(1.01, -1000.0)).epsilon(0.01));
+    test::check_spring_energy_decay([&](World& world) { use_local_global(world, iterations); });
   }
 }
 

@@ -227,7 +227,7 @@ TEST_CASE("scene error: a solver iteration limit for the default method") {
 TEST_CASE("scene error: substeps for a method other than xpbd") {
   check_bad_scene("substeps_without_xpbd.toml");
 }
-TEST_CASE("scene error: iterations for a method other than xpbd or local-global") {
+TEST_CASE("scene error: iterations for a method other than xpbd or local-global or vbd") {
   check_bad_scene("iterations_without_xpbd.toml");
 }
 TEST_CASE("scene error: xpbd with 0 substeps") {
@@ -238,6 +238,12 @@ TEST_CASE("scene error: local-global with 0 iterations") {
 }
 TEST_CASE("scene error: substeps for local-global") {
   check_bad_scene("substeps_with_local_global.toml");
+}
+TEST_CASE("scene error: vbd with 0 iterations") {
+  check_bad_scene("zero_iterations_vbd.toml");
+}
+TEST_CASE("scene error: substeps for vbd") {
+  check_bad_scene("substeps_with_vbd.toml");
 }
 
 // Not finite, or overflowing.
@@ -447,7 +453,7 @@ TEST_CASE("scene error: every bad scene file has a test case") {
   for (const auto& entry : fs::directory_iterator(fs::path(CLOTHLAB_TEST_SCENES) / "bad")) {
     if (entry.path().extension() == ".toml") ++files;
   }
-  CHECK(files == 122);
+  CHECK(files == 124);
 }
 
 TEST_CASE("scene error: a missing file") {

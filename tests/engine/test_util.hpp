@@ -107,6 +107,19 @@ duration = 1.5
 )";
 }
 
+// Steps `world` `steps` times by dt [s], requiring that no step ends with more energy than it
+// began with (beyond rounding, 1e-12 J); returns the energy at the end [J].
+inline double step_without_energy_growth(clothlab::World& world, double dt, int steps) {
+  double e = world.kinetic_energy() + world.potential_energy();
+  for (int s = 0; s < steps; ++s) {
+    world.step(dt);
+    const double next = world.kinetic_energy() + world.potential_energy();
+    REQUIRE(next <= e + 1e-12);
+    e = next;
+  }
+  return e;
+}
+
 // Steps `scene` through its whole duration: step_count() steps of its dt.
 inline void run_to_end(clothlab::Scene& scene) {
   for (long s = 0; s < scene.step_count(); ++s)

@@ -60,19 +60,6 @@ void run(World& world, double dt, long steps) {
     world.step(dt);
 }
 
-// Steps `world` `steps` times by dt [s], requiring that no step ends with more energy than it
-// began with (beyond rounding, 1e-12 J); returns the energy at the end [J].
-double step_without_energy_growth(World& world, double dt, int steps) {
-  double e = world.kinetic_energy() + world.potential_energy();
-  for (int s = 0; s < steps; ++s) {
-    world.step(dt);
-    const double next = world.kinetic_energy() + world.potential_energy();
-    REQUIRE(next <= e + 1e-12);
-    e = next;
-  }
-  return e;
-}
-
 // How far below its rest position (y = -links m) the bottom of the chain hangs [m].
 double sag(const World& world, int links) {
   return -static_cast<double>(links) - world.particles.x(1, links);
@@ -202,7 +189,7 @@ TEST_CASE("xpbd: the energy of an undamped spring never grows") {
   World world = test::anchored_spring(1.0, 100.0, 0.0, 0.1, 0.0);
   use_xpbd(world, 4, 1);
   const double e0 = world.kinetic_energy() + world.potential_energy();
-  const double e = step_without_energy_growth(world, 0.01, 1000);
+  const double e = test::step_without_energy_growth(world, 0.01, 1000);
   const double implicit_euler = e0 * std::pow(1.0 + 0.025 * 0.025, -4000.0);
   MESSAGE("energy " << e0 << " J -> " << e << " J; implicit Euler's factor gives " << implicit_euler
                     << " J");
@@ -252,7 +239,7 @@ TEST_CASE(
     World world = test::anchored_spring(1.0, 100.0, kd, 0.1, 0.0);
     use_xpbd(world, 4, 1);
     const double e0 = world.kinetic_energy() + world.potential_energy();
-    const double e = step_without_energy_growth(world, 0.01, 500);
+    const double e = test::step_without_energy_growth(world, 0.01, 500);
     // After 5 s the swing at 0.1 critical keeps exp(-2 zeta w t) = exp(-10) of its energy; the
     // overdamped spring creeps back as exp(-ks t / kd), keeping exp(-0.5) = 0.61 of it.
     CHECK(e < (kd == 2.0 ? 1e-4 : 0.7) * e0);

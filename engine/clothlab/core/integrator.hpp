@@ -3,9 +3,9 @@
 // An integrator asks the world for forces (World::compute_forces, as often as its method needs:
 // once for Euler, four times for RK4) and moves positions and velocities forward by dt. Each
 // method lives in its own file of engine/clothlab/integrators/ (euler, runge_kutta, verlet,
-// implicit_euler, xpbd, local_global), and a scene chooses one by name (integrators/methods.hpp).
-// An integrator may keep state between steps (buffers, the previous positions of position
-// Verlet), so each world owns its own.
+// implicit_euler, xpbd, local_global, vbd), and a scene chooses one by name
+// (integrators/methods.hpp). An integrator may keep state between steps (buffers, the previous
+// positions of position Verlet), so each world owns its own.
 #pragma once
 
 #include <string_view>

@@ -6,6 +6,7 @@
 #include "clothlab/integrators/implicit_euler.hpp"
 #include "clothlab/integrators/local_global.hpp"
 #include "clothlab/integrators/runge_kutta.hpp"
+#include "clothlab/integrators/vbd.hpp"
 #include "clothlab/integrators/verlet.hpp"
 #include "clothlab/integrators/xpbd.hpp"
 
@@ -24,7 +25,7 @@ std::unique_ptr<clothlab::Integrator> make() {
 }
 
 // Every method a scene may name, the engine's one list of them: first the force-based
-// integrators of lessons 01 to 08, then lesson 12's and lesson 13's.
+// integrators of lessons 01 to 08, then those of lessons 12, 13 and 14.
 constexpr std::array kMethods = {Method{"explicit-euler", make<ExplicitEuler>},
                                  Method{"symplectic-euler", make<SymplecticEuler>},
                                  Method{"midpoint", make<Midpoint>},
@@ -33,7 +34,8 @@ constexpr std::array kMethods = {Method{"explicit-euler", make<ExplicitEuler>},
                                  Method{"position-verlet", make<PositionVerlet>},
                                  Method{"implicit-euler", make<ImplicitEuler>},
                                  Method{"xpbd", make<Xpbd>},
-                                 Method{"local-global", make<LocalGlobal>}};
+                                 Method{"local-global", make<LocalGlobal>},
+                                 Method{"vbd", make<Vbd>}};
 constexpr size_t kForceBased = 7;  // the first seven move particles by forces
 
 // The table's names, for the lists below.

@@ -20,7 +20,8 @@ std::span<const std::string_view> integrator_names();
 
 // Every name a scene may give in [integrator] method = "...": integrator_names(), then lesson
 // 12's "xpbd", which moves particles by constraints instead of by spring forces, and lesson 13's
-// "local-global", which solves implicit Euler by local projections and a prefactored system.
+// "local-global", which solves implicit Euler by local projections and a prefactored system, and
+// lesson 14's "vbd", which solves it by Newton steps one vertex at a time.
 std::span<const std::string_view> method_names();
 
 // A new integrator of the method called `name`, or nullptr when no method has that name.
