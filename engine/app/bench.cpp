@@ -337,6 +337,7 @@ void add_bench_command(CLI::App& app) {
       [] { run_bench_command("accuracy", [] { return bench_accuracy(accuracy_options); }); });
 
   add_bench_methods_command(*bench);
+  add_bench_roofline_command(*bench);
 }
 
 }  // namespace clothlab::app

@@ -3,14 +3,26 @@
 
 #include <filesystem>
 #include <functional>
+#include <string>
 #include <string_view>
+#include <vector>
 
 #include <CLI/CLI.hpp>
 
 namespace clothlab::app {
 void add_bench_command(CLI::App& app);
-void add_bench_speed_command(CLI::App& bench);    // bench_speed.cpp
-void add_bench_methods_command(CLI::App& bench);  // bench_methods.cpp
+void add_bench_speed_command(CLI::App& bench);     // bench_speed.cpp
+void add_bench_methods_command(CLI::App& bench);   // bench_methods.cpp
+void add_bench_roofline_command(CLI::App& bench);  // bench_roofline.cpp
+
+// `bench speed`'s N x N cloth (bench_speed.cpp), for `bench roofline`: its scene, on the fast
+// path, on `threads` threads; and the engine's step on it, timed as `bench speed` times its
+// `reference` row on 1 thread: ns per spring-step, the median of `repeats` repeats of at least
+// `min_seconds` each.
+std::string speed_cloth_scene(int n, int threads);
+double reference_ns_per_spring_step(int n, int repeats, double min_seconds);
+// The option `--sizes N,N,...` of the commands that time bench speed's cloths.
+void add_cloth_sizes_option(CLI::App& command, std::vector<int>& sizes);
 
 // Runs `python3 script csv plot` (the plot scripts the bench commands write next to their CSV)
 // and, when the plot could not be drawn, warns how to get it.

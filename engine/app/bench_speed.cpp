@@ -655,6 +655,27 @@ int bench_speed(SpeedOptions opt) {
 
 }  // namespace
 
+std::string speed_cloth_scene(int n, int threads) {
+  return cloth_scene(n, threads, /*fast=*/true, "");
+}
+
+double reference_ns_per_spring_step(int n, int repeats, double min_seconds) {
+  SpeedOptions opt;
+  opt.variants = {"reference"};
+  opt.repeats = repeats;
+  opt.min_seconds = min_seconds;
+  std::vector<Measurement> rows;
+  measure_size(n, /*all_cores=*/1, opt, rows);
+  return rows.at(0).ns_per_spring_step;
+}
+
+void add_cloth_sizes_option(CLI::App& command, std::vector<int>& sizes) {
+  command.add_option("--sizes", sizes, "Cloth sizes N (N x N particles)")
+      ->delimiter(',')
+      ->check(CLI::Range(3, 2048))
+      ->capture_default_str();
+}
+
 void add_bench_speed_command(CLI::App& bench) {
   static SpeedOptions options;
   SpeedOptions& o = options;
@@ -662,10 +683,7 @@ void add_bench_speed_command(CLI::App& bench) {
       "speed",
       "The engine's speed on N x N cloths: ns per spring and step, steps per second, against a "
       "naive baseline, with effects added, on 1 thread and all cores (table and CSV)");
-  speed->add_option("--sizes", o.sizes, "Cloth sizes N (N x N particles)")
-      ->delimiter(',')
-      ->check(CLI::Range(3, 2048))
-      ->capture_default_str();
+  add_cloth_sizes_option(*speed, o.sizes);
   speed->add_option("--repeats", o.repeats, "Repeats of each measurement (the median is shown)")
       ->check(CLI::PositiveNumber)
       ->capture_default_str();

@@ -1,0 +1,433 @@
+// bench_roofline.cpp: `clothlab bench roofline`, the engine's step against this machine's limits.
+//
+// A roofline bounds how fast a program can run on a machine from what the program must do and
+// what the machine can do of it per second. A spring of the engine room's symplectic Euler step
+// (engine/fast/springs.cpp, through the reference kernel of solutions/02_spring_dampers.cpp) must
+// take one square root (l = |e*|) and one division (1 / l), its slowest instructions; and the
+// step must move the particles' state and the springs' constants between the processor and
+// wherever they are kept. The bench measures, on one thread:
+//
+//   arithmetic  the throughput of square root, division, and the two in a row as a spring has
+//               them, in double and in float: a loop that does nothing else over kValues
+//               independent values in the first-level cache, compiled as the engine's spring
+//               loops are (the same flags; vectorised across values, as they are across
+//               springs), and the same loop one value at a time;
+//   memory      a streaming copy and a streaming read over arrays well past the last-level cache;
+//   a floor     for each of bench speed's cloths: compute, a square root then a division per
+//               spring; bandwidth, the bytes the step must move at the rate of a streaming copy
+//               over as many bytes as the step touches (so the rate of whichever level of the
+//               memory holds them); the floor is the larger of the two;
+//   the engine  bench speed's `reference` row on 1 thread (its own code, run from here), and its
+//               ratio to the floor.
+//
+// Limits are the fastest of their repeats (a busy machine only slows a repeat: the fastest is the
+// nearest to what the machine can do), the engine the median of its repeats, as in bench speed.
+// engine/fast/SPEED.md ("The roofline") explains the model and what it leaves out.
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdint>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include <fmt/format.h>
+#include <CLI/CLI.hpp>
+
+#include "app/bench.hpp"
+#include "app/build_info.hpp"
+#include "clothlab/forces/gravity.hpp"
+#include "clothlab/forces/spring_damper.hpp"
+#include "fast/springs.hpp"
+#include "io/files.hpp"
+#include "scene/scene.hpp"
+
+// The arithmetic loops' twins that take one value at a time: the compiler must not vectorise them.
+#if defined(__clang__)
+#define CLOTHLAB_NOT_VECTORISED
+#define CLOTHLAB_NOT_VECTORISED_LOOP _Pragma("clang loop vectorize(disable) interleave(disable)")
+#else
+#define CLOTHLAB_NOT_VECTORISED __attribute__((optimize("no-tree-vectorize")))
+#define CLOTHLAB_NOT_VECTORISED_LOOP
+#endif
+
+namespace clothlab::app {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+struct RooflineOptions {
+  std::vector<int> sizes{64, 128, 256, 512};
+  int repeats = 5;
+  double min_seconds = 0.25;  // [s] one repeat of the engine's step; a hundredth for the limits
+  double stream_mib = 0.0;    // [MiB] each array of the memory figures; 0: 4 x the last level
+  std::string csv;
+  bool quick = false;
+};
+
+// The least wall time [s] of one call of work(), over `repeats` repeats of as many calls as last
+// `seconds` (calibrated on batches of 1, 2, 4, ... calls first).
+template <class Work>
+double fastest_call(int repeats, double seconds, Work work) {
+  long calls = 1;
+  for (;; calls *= 2) {
+    const Clock::time_point start = Clock::now();
+    for (long c = 0; c < calls; ++c)
+      work();
+    const double elapsed = std::chrono::duration<double>(Clock::now() - start).count();
+    if (elapsed >= seconds / 4 || calls >= (1L << 40)) {
+      calls = std::max(1L, std::lround(static_cast<double>(calls) * seconds / elapsed));
+      break;
+    }
+  }
+  double best = HUGE_VAL;
+  for (int r = 0; r < repeats; ++r) {
+    const Clock::time_point start = Clock::now();
+    for (long c = 0; c < calls; ++c)
+      work();
+    best = std::min(best, std::chrono::duration<double>(Clock::now() - start).count() /
+                              static_cast<double>(calls));
+  }
+  return best;
+}
+
+// --- Arithmetic ----------------------------------------------------------------------------
+//
+// A pass replaces each of kValues values by op(value). The values are independent, so the
+// processor has hundreds of operations in flight and the loop runs at the units' throughput, not
+// at their latency. Each pass is a call of its own, kept out of line, so that the compiler cannot
+// turn the loops inside out (one value through every pass: a chain, latency again). No value
+// drifts to 0, 1 or infinity, which some dividers take faster: each op keeps a full mantissa
+// (sqrt(v) 1.1 tends to 1.21, 1.7 / v swaps two values, 1.7 / sqrt(v) tends to 1.7^(2/3)).
+
+constexpr long kValues = 512;  // 4 KiB of doubles: in the first-level cache
+
+template <class T, class Op>
+[[gnu::noinline]] void pass_vectorised(T* __restrict values, Op op) {
+  for (long k = 0; k < kValues; ++k)
+    values[k] = op(values[k]);
+}
+
+template <class T, class Op>
+[[gnu::noinline]] CLOTHLAB_NOT_VECTORISED void pass_one_at_a_time(T* __restrict values, Op op) {
+  CLOTHLAB_NOT_VECTORISED_LOOP
+  for (long k = 0; k < kValues; ++k)
+    values[k] = op(values[k]);
+}
+
+struct Throughput {
+  double per_lane = 0.0;  // [ns] per value, the loop vectorised
+  double scalar = 0.0;    // [ns] per value, one value an instruction
+};
+
+template <class T, class Op>
+Throughput measure_op(Op op, int repeats, double seconds) {
+  std::vector<T> values(kValues);
+  const auto reset = [&] {
+    for (long k = 0; k < kValues; ++k)
+      values[static_cast<size_t>(k)] = T(1) + T(k) / T(kValues);
+  };
+  reset();
+  const double vectorised =
+      fastest_call(repeats, seconds, [&] { pass_vectorised(values.data(), op); });
+  reset();
+  const double scalar =
+      fastest_call(repeats, seconds, [&] { pass_one_at_a_time(values.data(), op); });
+  if (!std::isfinite(values[0])) throw std::logic_error("the arithmetic loop left its range");
+  return {1e9 * vectorised / kValues, 1e9 * scalar / kValues};
+}
+
+struct Arithmetic {
+  Throughput sqrt_d, div_d, pair_d, sqrt_f, div_f, pair_f;
+};
+
+template <class T>
+void measure_ops(Throughput& sqrt_op, Throughput& div_op, Throughput& pair_op, int repeats,
+                 double seconds) {
+  // The multiplication of the first is not a division nor a root: it runs beside them, free.
+  sqrt_op = measure_op<T>([](T v) { return std::sqrt(v) * T(1.1); }, repeats, seconds);
+  div_op = measure_op<T>([](T v) { return T(1.7) / v; }, repeats, seconds);
+  // A spring's pair: l = sqrt(e* . e*), then 1 / l, which waits for l.
+  pair_op = measure_op<T>([](T v) { return T(1.7) / std::sqrt(v); }, repeats, seconds);
+}
+
+Arithmetic measure_arithmetic(int repeats, double seconds) {
+  Arithmetic a;
+  measure_ops<double>(a.sqrt_d, a.div_d, a.pair_d, repeats, seconds);
+  measure_ops<float>(a.sqrt_f, a.div_f, a.pair_f, repeats, seconds);
+  return a;
+}
+
+// --- Memory --------------------------------------------------------------------------------
+//
+// 64-bit words. The copy writes b = a xor s, with s = 0 known only at run time: a plain copy loop
+// may become a call to memcpy, whose string moves can write whole cache lines without reading
+// them first, which no store of the engine's loops does. The read takes the bitwise or of every
+// word (associative, so it is vectorised, unlike a sum of doubles).
+
+[[gnu::noinline]] void copy_words(const std::uint64_t* __restrict a, std::uint64_t* __restrict b,
+                                  long n, std::uint64_t s) {
+  for (long i = 0; i < n; ++i)
+    b[i] = a[i] ^ s;
+}
+
+[[gnu::noinline]] std::uint64_t read_words(const std::uint64_t* __restrict a, long n) {
+  std::uint64_t bits = 0;
+  for (long i = 0; i < n; ++i)
+    bits |= a[i];
+  return bits;
+}
+
+// The largest cache of the first processor, as Linux describes it [bytes]; 0 if it does not.
+double last_level_cache_bytes() {
+  double largest = 0.0;
+  for (int index = 0; index < 8; ++index) {
+    std::ifstream in(fmt::format("/sys/devices/system/cpu/cpu0/cache/index{}/size", index));
+    double size = 0.0;
+    std::string unit;
+    if (!(in >> size)) continue;
+    in >> unit;
+    const double scale = unit == "K"   ? 1024.0
+                         : unit == "M" ? 1048576.0
+                         : unit == "G" ? 1073741824.0
+                                       : 1.0;
+    largest = std::max(largest, size * scale);
+  }
+  return largest;
+}
+
+struct Memory {
+  std::vector<std::uint64_t> a, b;
+  double array_bytes = 0.0;  // of each array, for the figures past the last-level cache
+  std::string why_size;
+  double copy_gbs = 0.0, read_gbs = 0.0;  // [GB/s] past the last-level cache
+};
+
+// A copy pass over `bytes` bytes in all (bytes / 2 read, bytes / 2 written) [GB/s], fastest of
+// the repeats; the copy of the memory figures is the same with bytes = 2 arrays.
+double copy_gbs(Memory& m, double bytes, int repeats, double seconds) {
+  const long words = std::max(1L, std::lround(bytes / 16.0));
+  const std::uint64_t zero = static_cast<std::uint64_t>(m.b.size() == 0);  // 0, unknown to GCC
+  const double s =
+      fastest_call(repeats, seconds, [&] { copy_words(m.a.data(), m.b.data(), words, zero); });
+  return 16.0 * static_cast<double>(words) / s * 1e-9;
+}
+
+// --- The bytes of a step -------------------------------------------------------------------
+
+struct StepBytes {
+  long particles = 0;
+  long springs = 0;
+  double moved = 0.0;    // [bytes] the least a step moves, each array once
+  double touched = 0.0;  // [bytes] every byte a step reads or writes, counted once
+};
+
+// From the engine room's layout (fast/engine.cpp, fast/copies.hpp, fast/springs.cpp), for a cloth
+// of springs and gravity moved by symplectic Euler:
+//   per particle: x and v read and written in the engine's layout (4 x 24 bytes), f written
+//     (24), 1/m read by the move (8), m read by gravity (8): 136 bytes moved. The step also
+//     writes copies of x, v and f in the structure-of-arrays layout and reads them back (72
+//     bytes, 216 moved if they leave the cache between the two): touched, not counted as moved;
+//   per spring: its l0 (8 bytes); and its ks and kd (16) unless its run is uniform, whose ks and
+//     kd are read once for the run (16 bytes a run).
+StepBytes step_bytes(const World& world) {
+  StepBytes b;
+  b.particles = static_cast<long>(world.particles.size());
+  const double p = static_cast<double>(b.particles);
+  b.moved = 4 * 24 * p + 24 * p + 8 * p;
+  b.touched = (3 * 24 + 8 + 3 * 24) * p;
+  for (const auto& effect : world.force_effects) {
+    if (dynamic_cast<const UniformGravity*>(effect.get())) {
+      b.moved += 8 * p;
+      b.touched += 8 * p;
+    } else if (const auto* s = dynamic_cast<const SpringDampers*>(effect.get())) {
+      double constants = 8.0 * static_cast<double>(s->springs().size());
+      for (const fast::SpringRun& run : fast::spring_runs(s->springs()))
+        constants += run.uniform ? 16.0 : 16.0 * static_cast<double>(run.length);
+      b.springs += static_cast<long>(s->springs().size());
+      b.moved += constants;
+      b.touched += constants;
+    } else {
+      throw std::logic_error(fmt::format("no byte count for the effect \"{}\"", effect->name()));
+    }
+  }
+  return b;
+}
+
+// --- The table -----------------------------------------------------------------------------
+
+struct Row {
+  int n = 0;
+  StepBytes bytes;
+  double copy_gbs = 0.0;      // [GB/s] a streaming copy over bytes.touched
+  double compute_ns = 0.0;    // [ns per spring] a square root then a division
+  double bandwidth_ns = 0.0;  // [ns per spring] bytes.moved at copy_gbs
+  double engine_ns = 0.0;     // [ns per spring-step] bench speed's reference, 1 thread
+  double floor_ns() const { return std::max(compute_ns, bandwidth_ns); }
+};
+
+std::string load_average() {
+  double load[1];
+  return getloadavg(load, 1) == 1 ? fmt::format("{:.2f}", load[0]) : "unknown";
+}
+
+int bench_roofline(RooflineOptions opt) {
+  if (opt.quick) {
+    opt.sizes = {16, 32};
+    opt.repeats = 3;
+    opt.min_seconds = 0.02;
+    if (opt.stream_mib == 0.0) opt.stream_mib = 16.0;
+  }
+  // The limits in many short repeats: on a machine shared with other programs, a repeat shorter
+  // than the scheduler's time slice often runs alone on its core, and the fastest one counts.
+  const double seconds = opt.min_seconds / 100;
+  const int limit_repeats = std::max(3, 4 * opt.repeats);
+  const int stream_repeats = std::max(3, opt.repeats);  // a pass past the cache takes long anyway
+  fmt::print(
+      "bench roofline: this machine's limits on one thread, and the engine's symplectic Euler "
+      "step\n  against them ({} build, {}; load average {} at the start)\n\n",
+      kKernels,
+      kLinkTimeOptimised ? "kernels inlined by link-time optimisation"
+                         : "link-time optimisation off: the spring loops are not vectorised",
+      load_average());
+
+  const Arithmetic a = measure_arithmetic(limit_repeats, seconds);
+  fmt::print(
+      "  arithmetic: {} independent values in the first-level cache, each pass replacing every one "
+      "(fastest of {} repeats)\n",
+      kValues, limit_repeats);
+  fmt::print("  {:<34} {:>15} {:>15} {:>15} {:>15}\n", "ns per value", "double, vector",
+             "double, scalar", "float, vector", "float, scalar");
+  const auto op_row = [](const char* name, const Throughput& d, const Throughput& f) {
+    fmt::print("  {:<34} {:>15.3f} {:>15.3f} {:>15.3f} {:>15.3f}\n", name, d.per_lane, d.scalar,
+               f.per_lane, f.scalar);
+  };
+  op_row("square root", a.sqrt_d, a.sqrt_f);
+  op_row("division", a.div_d, a.div_f);
+  op_row("square root, then division", a.pair_d, a.pair_f);
+  fmt::print(
+      "  (vector: the loop compiled as the engine's spring loops, several values an instruction; "
+      "ns per lane.\n   scalar: the same loop one value an instruction; ns per operation.)\n\n");
+
+  // The memory figures, past the last-level cache: 4 times its size, within 64 MiB to 2 GiB.
+  Memory m;
+  const double llc = last_level_cache_bytes();
+  if (opt.stream_mib > 0.0) {
+    m.array_bytes = opt.stream_mib * 1048576.0;
+    m.why_size = opt.quick ? "--quick: a test of the wiring, not past the caches" : "--stream-mib";
+  } else {
+    m.array_bytes = std::clamp(4.0 * llc, 64.0 * 1048576.0, 2048.0 * 1048576.0);
+    m.why_size = llc > 0.0 ? fmt::format("the last-level cache is {:.0f} MiB", llc / 1048576.0)
+                           : "the cache sizes are unknown";
+  }
+  // Room for the cloths' copies too, each over as many bytes as the step touches.
+  std::vector<Row> rows;
+  double largest = m.array_bytes;
+  for (int n : opt.sizes) {
+    Row row;
+    row.n = n;
+    row.bytes = step_bytes(parse_scene(speed_cloth_scene(n, 1), "<bench roofline>").world);
+    largest = std::max(largest, row.bytes.touched / 2);
+    rows.push_back(row);
+  }
+  const size_t words = static_cast<size_t>(std::ceil(largest / 8));
+  m.a.resize(words);
+  m.b.resize(words);
+  for (size_t i = 0; i < words; ++i)  // every page touched before the clock starts
+    m.a[i] = i;
+  const long stream_words = std::lround(m.array_bytes / 8);
+  m.copy_gbs = copy_gbs(m, 16.0 * static_cast<double>(stream_words), stream_repeats, seconds);
+  std::uint64_t bits = 0;
+  const double read_s =
+      fastest_call(stream_repeats, seconds, [&] { bits |= read_words(m.a.data(), stream_words); });
+  m.read_gbs = 8.0 * static_cast<double>(stream_words) / read_s * 1e-9;
+  if (bits == 0) throw std::logic_error("the streaming read read nothing");
+  fmt::print(
+      "  memory: arrays of {:.0f} MiB each ({}), fastest of {} repeats\n"
+      "    streaming copy, b = a xor s (8 bytes read and 8 written a word)  {:8.2f} GB/s\n"
+      "    streaming read, the or of every word                             {:8.2f} GB/s\n\n",
+      m.array_bytes / 1048576.0, m.why_size, stream_repeats, m.copy_gbs, m.read_gbs);
+
+  for (Row& row : rows) {
+    row.copy_gbs = copy_gbs(m, row.bytes.touched, limit_repeats, seconds);
+    row.compute_ns = a.pair_d.per_lane;
+    row.bandwidth_ns = row.bytes.moved / row.copy_gbs / static_cast<double>(row.bytes.springs);
+    row.engine_ns = reference_ns_per_spring_step(row.n, opt.repeats, opt.min_seconds);
+  }
+
+  fmt::print(
+      "  the floor of a step, per spring: compute = a square root then a division (double, "
+      "vector); bandwidth =\n  the bytes a step moves at a streaming copy's rate over as many "
+      "bytes as it touches; floor = the larger.\n  engine: bench speed's reference, 1 thread, "
+      "median of {} repeats of at least {} s.\n",
+      opt.repeats, opt.min_seconds);
+  fmt::print("  {:>4} {:>8} {:>8} {:>9} {:>9} {:>10} {:>10} {:>8}  {:<9} {:>9} {:>12}\n", "N",
+             "springs", "data MB", "B/spring", "copy GB/s", "compute ns", "bandwidth", "floor ns",
+             "bound by", "engine ns", "engine/floor");
+  for (const Row& r : rows) {
+    fmt::print(
+        "  {:>4} {:>8} {:>8.2f} {:>9.1f} {:>9.2f} {:>10.3f} {:>10.3f} {:>8.3f}  {:<9} {:>9.3f} "
+        "{:>12.2f}\n",
+        r.n, r.bytes.springs, r.bytes.touched * 1e-6,
+        r.bytes.moved / static_cast<double>(r.bytes.springs), r.copy_gbs, r.compute_ns,
+        r.bandwidth_ns, r.floor_ns(), r.compute_ns >= r.bandwidth_ns ? "compute" : "bandwidth",
+        r.engine_ns, r.engine_ns / r.floor_ns());
+  }
+  fmt::print("  (load average {} at the end)\n", load_average());
+
+  if (!opt.csv.empty()) {
+    const std::filesystem::path csv = opt.csv;
+    if (csv.has_parent_path()) std::filesystem::create_directories(csv.parent_path());
+    std::string table =
+        "n,particles,springs,data_bytes,bytes_per_spring,copy_gb_per_s,compute_floor_ns,"
+        "bandwidth_floor_ns,floor_ns,engine_ns,engine_over_floor\n";
+    for (const Row& r : rows) {
+      fmt::format_to(std::back_inserter(table),
+                     "{},{},{},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},"
+                     "{:.6g},{:.6g}\n",
+                     r.n, r.bytes.particles, r.bytes.springs, r.bytes.touched,
+                     r.bytes.moved / static_cast<double>(r.bytes.springs), r.copy_gbs, r.compute_ns,
+                     r.bandwidth_ns, r.floor_ns(), r.engine_ns, r.engine_ns / r.floor_ns());
+    }
+    write_whole_file(csv, table);
+    fmt::print("\n  wrote {}\n", csv.string());
+  }
+  return 0;
+}
+
+}  // namespace
+
+void add_bench_roofline_command(CLI::App& bench) {
+  static RooflineOptions options;
+  RooflineOptions& o = options;
+  CLI::App* roofline = bench.add_subcommand(
+      "roofline",
+      "This machine's limits (square root and division throughput, memory bandwidth) and the "
+      "engine's step on N x N cloths against the floor they set (table and CSV)");
+  add_cloth_sizes_option(*roofline, o.sizes);
+  roofline->add_option("--repeats", o.repeats, "Repeats of each measurement")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
+  roofline
+      ->add_option(
+          "--min-seconds", o.min_seconds,
+          "Wall time [s] of each repeat of the engine's step (a hundredth for the limits')")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
+  roofline
+      ->add_option("--stream-mib", o.stream_mib,
+                   "Size [MiB] of each array of the memory figures (default: 4 x the last-level "
+                   "cache, within 64 to 2048)")
+      ->check(CLI::Range(1.0, 65536.0));
+  roofline->add_option("--csv", o.csv, "Write one row per cloth size to this CSV file");
+  roofline->add_flag("--quick", o.quick,
+                     "Sizes 16 and 32, short repeats, 16 MiB arrays (for tests)");
+  roofline->callback([] { run_bench_command("roofline", [] { return bench_roofline(options); }); });
+}
+
+}  // namespace clothlab::app
