@@ -19,10 +19,17 @@
 // `--speed`: on cloths of 64 x 64, 128 x 128 and 256 x 256 particles, on 1 and 2 threads, what
 // a symplectic Euler step, an XPBD iteration and a local/global iteration cost per spring, each
 // on the readable path (no backend) and in the engine room (engine/fast/), measured in the same
-// run, and the targets beside the ratios.
+// run, and the targets beside the ratios. Beside each target, what bounds it, measured in
+// the same run: for an XPBD iteration, the engine room's same passes with no square root or
+// division (FastEngine::xpbd_access_passes: the gathers and scatters alone); for local/global,
+// its solve alone.
 //
 // Implicit Euler's rows: ns per spring per conjugate-gradient iteration, readable and engine
 // room, with the iterations per step, and a streaming pass over as many bytes as the bound.
+//
+// Vertex Block Descent's rows (lesson 14; readable only, it has no engine room): a step of one
+// iteration and an iteration, ns per spring and per vertex, against the engine room's symplectic
+// Euler step of the same run.
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -813,8 +820,9 @@ void add_bench_methods_command(CLI::App& bench) {
       ->check(CLI::PositiveNumber)
       ->capture_default_str();
   methods->add_flag("--speed", options.speed,
-                    "Also time a symplectic Euler step, an XPBD iteration and a local/global "
-                    "iteration per spring, readable and engine room, on 1 and 2 threads");
+                    "Also time a symplectic Euler step, an XPBD iteration, a CG iteration of "
+                    "implicit Euler and a local/global iteration per spring, readable and engine "
+                    "room, and a VBD iteration (readable), on 1 and 2 threads");
   methods
       ->add_option("--grid", options.grids,
                    "The speed measurement's cloths: N x N particles (one or more N)")
