@@ -19,10 +19,17 @@
 // `--speed`: on cloths of 64 x 64, 128 x 128 and 256 x 256 particles, on 1 and 2 threads, what
 // a symplectic Euler step, an XPBD iteration and a local/global iteration cost per spring, each
 // on the readable path (no backend) and in the engine room (engine/fast/), measured in the same
-// run, and the targets beside the ratios.
+// run, and the targets beside the ratios. Beside each target, what bounds it, measured in
+// the same run: for an XPBD iteration, the engine room's same passes with no square root or
+// division (FastEngine::xpbd_access_passes: the gathers and scatters alone); for local/global,
+// its solve alone.
 //
 // Implicit Euler's rows: ns per spring per conjugate-gradient iteration, readable and engine
 // room, with the iterations per step, and a streaming pass over as many bytes as the bound.
+//
+// Vertex Block Descent's rows (lesson 14; readable only, it has no engine room): a step of one
+// iteration and an iteration, ns per spring and per vertex, against the engine room's symplectic
+// Euler step of the same run.
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -45,6 +52,8 @@
 #include "clothlab/integrators/implicit_euler.hpp"
 #include "clothlab/integrators/local_global.hpp"
 #include "clothlab/integrators/methods.hpp"
+#include "clothlab/integrators/xpbd.hpp"
+#include "fast/engine.hpp"
 #include "io/files.hpp"
 #include "scene/scene.hpp"
 
@@ -368,7 +377,8 @@ std::string speed_scene(int grid, std::string_view method, int substeps, int ite
       "[gravity]\ng = [0.0, -9.8, 0.0]\n[integrator]\nmethod = \"{1}\"\ndt = 1e-4\n"
       "duration = 1.0\n",
       grid, method);
-  if (substeps > 0) text += fmt::format("substeps = {}\niterations = {}\n", substeps, iterations);
+  if (substeps > 0) text += fmt::format("substeps = {}\n", substeps);
+  if (iterations > 0) text += fmt::format("iterations = {}\n", iterations);
   return text;
 }
 
@@ -439,11 +449,47 @@ double streaming_ns_per_spring(size_t springs, int threads) {
   return 1e9 * best / static_cast<double>(springs) + 0.0 * y[n / 2];
 }
 
+// The bound on an XPBD iteration in the engine room [ns per spring per pass]: the fastest of
+// `repeats` runs of `steps` calls of FastEngine::xpbd_access_passes (the iteration's passes with
+// no square root or division) with 1 + `more` passes, less the fastest with 1, over `more`: as
+// the iteration itself is measured, on the constraints a step of the same scene built.
+double xpbd_access_ns(const std::string& text, size_t springs, int steps, int repeats, int threads,
+                      int more) {
+  World world = std::move(parse_scene(text, "<speed>").world);
+  world.threads = threads;
+  world.step(1e-4);  // builds the constraints, as the timed XPBD steps do
+  auto* engine = dynamic_cast<fast::FastEngine*>(world.backend.get());
+  const auto* xpbd = dynamic_cast<const Xpbd*>(world.integrator.get());
+  if (!engine || !xpbd) return kNaN;
+  const XpbdConstraints& constraints = xpbd->constraints();
+  const Matrix3X x_old = world.particles.x;
+  std::vector<double> lambda(constraints.size(), 0.0);
+  const auto best = [&](int passes) {
+    double fastest = std::numeric_limits<double>::infinity();
+    for (int r = 0; r < repeats; ++r) {
+      const Clock::time_point start = Clock::now();
+      for (int s = 0; s < steps; ++s)
+        engine->xpbd_access_passes(world, constraints, x_old, 1e-4, passes, lambda);
+      fastest = std::min(fastest, std::chrono::duration<double>(Clock::now() - start).count());
+    }
+    return fastest;
+  };
+  const double one = best(1), many = best(1 + more);
+  return 1e9 * (many - one) / (static_cast<double>(springs) * steps * more);
+}
+
+// The extra iterations whose cost is the cost of an iteration (XPBD's, VBD's, the bound's).
+constexpr int kSpeedMore = 8;
+
 // One grid's figures on one number of threads [ns per spring].
 struct SpeedRow {
   int grid = 0, threads = 0;
   size_t springs = 0;
   double euler[2] = {}, xpbd_one[2] = {}, xpbd_iteration[2] = {};  // [readable, engine room]
+  // The XPBD iteration's passes with no square root or division (xpbd_access_ns): its bound.
+  double xpbd_access = 0.0;
+  // Vertex Block Descent (lesson 14), readable only: a step of one iteration and an iteration.
+  double vbd_one = 0.0, vbd_iteration = 0.0;
 
   // Implicit Euler: ns per spring per conjugate-gradient iteration, and iterations per step.
   double cg_iteration[2] = {}, cg_iterations[2] = {};
@@ -461,7 +507,7 @@ void measure_local_global(SpeedRow& row, int grid, int threads, bool quick) {
   constexpr int kLgMore = 4;
   const double per = 1e9 / (static_cast<double>(row.springs) * steps);
   const auto text = [&](int iterations) {
-    return speed_scene(grid, "local-global", 0, 0) + fmt::format("iterations = {}\n", iterations);
+    return speed_scene(grid, "local-global", 0, iterations);
   };
   for (int fast = 0; fast < 2; ++fast) {
     const double one = per * time_steps(text(1), steps, repeats, threads, fast == 1, 1);
@@ -500,15 +546,22 @@ SpeedRow measure_speed(int grid, int threads, bool quick) {
       row.springs += s->springs().size();
   }
   const double per = 1e9 / (static_cast<double>(row.springs) * steps);  // s per run -> ns
-  constexpr int kMore = 8;  // the extra iterations whose cost is the cost of an iteration
   for (int fast = 0; fast < 2; ++fast) {
     const auto time = [&](const std::string& text) {
       return per * time_steps(text, steps, repeats, threads, fast == 1);
     };
     row.euler[fast] = time(speed_scene(grid, "symplectic-euler", 0, 0));
     row.xpbd_one[fast] = time(speed_scene(grid, "xpbd", 1, 1));
-    const double many = time(speed_scene(grid, "xpbd", 1, 1 + kMore));
-    row.xpbd_iteration[fast] = (many - row.xpbd_one[fast]) / kMore;
+    const double many = time(speed_scene(grid, "xpbd", 1, 1 + kSpeedMore));
+    row.xpbd_iteration[fast] = (many - row.xpbd_one[fast]) / kSpeedMore;
+    if (fast == 1) {
+      row.xpbd_access = xpbd_access_ns(speed_scene(grid, "xpbd", 1, 1), row.springs, steps, repeats,
+                                       threads, kSpeedMore);
+    } else {  // VBD has no engine room: its readable loop alone
+      row.vbd_one = time(speed_scene(grid, "vbd", 0, 1));
+      row.vbd_iteration =
+          (time(speed_scene(grid, "vbd", 0, 1 + kSpeedMore)) - row.vbd_one) / kSpeedMore;
+    }
 
     // Implicit Euler at 1/600 s, a tenth of a frame: the solves time its iterations.
     const CgTiming cg = time_cg(speed_scene(grid, "implicit-euler", 0, 0), quick ? 2 : 6,
@@ -570,6 +623,17 @@ void speed(const MethodsOptions& opt, const fs::path& out_dir) {
                  one.grid == 128 ? (euler >= 1.7 && xpbd >= 1.7 ? " (met)" : " (missed)") : "");
     }
     fmt::print("\n");
+    // What bounds it: the same passes, gathers and scatters with no square root or division.
+    fmt::print(
+        "    bound: the iteration's passes with no square root or division (the gathers and "
+        "scatters alone) take {:.2f} ns per spring on 1 thread, {:.2f} Euler steps",
+        one.xpbd_access, one.xpbd_access / one.euler[1]);
+    for (const SpeedRow& two : rows) {
+      if (two.grid == one.grid && two.threads == 2)
+        fmt::print("; {:.2f} on 2 threads", two.xpbd_access);
+    }
+    fmt::print("; the XPBD iteration is {:.2f} times them\n",
+               one.xpbd_iteration[1] / one.xpbd_access);
   }
   for (const SpeedRow& one : rows) {
     if (one.threads != 1) continue;
@@ -627,6 +691,23 @@ void speed(const MethodsOptions& opt, const fs::path& out_dir) {
         stream1, stream2, stream1 / stream2, one.cg_iteration[1] / stream1);
   }
 
+  // Vertex Block Descent, readable only.
+  fmt::print(
+      "\n  VBD (lesson 14), readable only (no engine room): ns per spring and per vertex, an "
+      "iteration = (a step of {} iterations - a step of 1) / {}\n",
+      1 + kSpeedMore, kSpeedMore);
+  fmt::print("  {:>9} {:>7} | {:>14} | {:>21} | {:>16} | {:>16}\n", "grid", "threads",
+             "step, 1 it.", "VBD iteration", "Euler step", "VBD it./Euler");
+  fmt::print("  {:>9} {:>7} | {:>14} | {:>10} {:>10} | {:>16} | {:>16}\n", "", "", "per spring",
+             "per spring", "per vertex", "engine, per vtx", "step (engine)");
+  for (const SpeedRow& r : rows) {
+    const double vertices = static_cast<double>(r.grid) * r.grid;
+    const double per_vertex = static_cast<double>(r.springs) / vertices;  // ns/spring -> ns/vertex
+    fmt::print("  {:>9} {:>7} | {:14.2f} | {:10.2f} {:10.2f} | {:16.2f} | {:16.2f}\n",
+               fmt::format("{0} x {0}", r.grid), r.threads, r.vbd_one, r.vbd_iteration,
+               r.vbd_iteration * per_vertex, r.euler[1] * per_vertex, r.vbd_iteration / r.euler[1]);
+  }
+
   std::string table = "grid,springs,measure,ns_per_spring,threads\n";
   for (const SpeedRow& r : rows) {
     for (int fast = 0; fast < 2; ++fast) {
@@ -642,6 +723,10 @@ void speed(const MethodsOptions& opt, const fs::path& out_dir) {
       add("implicit-euler-cg-iteration", r.cg_iteration[fast]);
       add("local-global-iteration", r.lg_iteration[fast]);
     }
+    table += fmt::format("{},{},vbd-step-1-iteration-readable,{:.6g},{}\n", r.grid, r.springs,
+                         r.vbd_one, r.threads);
+    table += fmt::format("{},{},vbd-iteration-readable,{:.6g},{}\n", r.grid, r.springs,
+                         r.vbd_iteration, r.threads);
   }
   write_whole_file(out_dir / "speed.csv", table);
   fmt::print("  wrote {}\n", (out_dir / "speed.csv").string());
@@ -735,8 +820,9 @@ void add_bench_methods_command(CLI::App& bench) {
       ->check(CLI::PositiveNumber)
       ->capture_default_str();
   methods->add_flag("--speed", options.speed,
-                    "Also time a symplectic Euler step, an XPBD iteration and a local/global "
-                    "iteration per spring, readable and engine room, on 1 and 2 threads");
+                    "Also time a symplectic Euler step, an XPBD iteration, a CG iteration of "
+                    "implicit Euler and a local/global iteration per spring, readable and engine "
+                    "room, and a VBD iteration (readable), on 1 and 2 threads");
   methods
       ->add_option("--grid", options.grids,
                    "The speed measurement's cloths: N x N particles (one or more N)")

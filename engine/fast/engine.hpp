@@ -93,6 +93,13 @@ class FastEngine final : public Backend {
   bool xpbd_project(World& world, const XpbdConstraints& constraints, const Matrix3X& x_old,
                     double h, int iterations, bool keep_lambda,
                     std::vector<double>& lambda) override;
+  // xpbd_project's passes (the fast layout, the colours in order, each split over the threads,
+  // the same loads and stores) with each projection replaced by a few multiply-adds: no square
+  // root, no division. What the access pattern alone costs: the bound `clothlab bench methods
+  // --speed` prints beside an XPBD iteration. It moves the particles by next to nothing and is
+  // no method.
+  void xpbd_access_passes(World& world, const XpbdConstraints& constraints, const Matrix3X& x_old,
+                          double h, int iterations, std::vector<double>& lambda);
   bool implicit_euler_step(World& world, double dt, double tolerance, int max_iterations,
                            VectorX& dv, LinearSolveStats& stats) override;
 #if defined(CLOTHLAB_CHOLMOD)

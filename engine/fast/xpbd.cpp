@@ -8,6 +8,11 @@
 // on any number of threads. The positions are read from a structure of arrays (all x, then all
 // y, then all z), so that, with the kernel inlined (link-time optimisation), the compiler may
 // project several constraints of a colour at once with vector instructions. SPEED.md measures it.
+//
+// xpbd_access_passes makes the same passes with the projection replaced by a few multiply-adds
+// (access_only): what the layout, the colour order, the gathers and the scatters cost without
+// the projection's square roots and divisions, the bound `clothlab bench methods --speed`
+// prints beside an XPBD iteration.
 #include <algorithm>
 #include <vector>
 
@@ -20,14 +25,29 @@ namespace clothlab::fast {
 
 namespace {
 
-// Constraints [begin, end) of one colour projected once: Xpbd::advance's loop on a range, the
-// positions in the fast layout (component d of particle i at x[d nx + i]). No two of these
-// constraints share a particle (the colouring), which is what the vectorise hint says.
+// The bound's stand-in for xpbd_project: the same arguments read and the same two ends and
+// multiplier returned, joined by multiply-adds alone (no square root, no division, no branch).
+// It moves each end by about 1e-15 of the spacing a pass: no method, only the access pattern.
+inline double access_only(Vec3& x_i, Vec3& x_j, const Vec3& old_i, const Vec3& old_j, double w_i,
+                          double w_j, double ks, double kd, double l0, double h, double lambda) {
+  const Vec3 d = x_i - x_j;
+  const double c = d.squaredNorm() - l0 * l0 + kd * d.dot((x_i - old_i) - (x_j - old_j));
+  const double delta = -1e-12 * h * (ks * c + lambda);
+  x_i += (w_i * delta) * d;
+  x_j -= (w_j * delta) * d;
+  return delta;
+}
+
+// Constraints [begin, end) of one colour projected once by `kernel` (xpbd_project, or
+// access_only): Xpbd::advance's loop on a range, the positions in the fast layout (component d
+// of particle i at x[d nx + i]). No two of these constraints share a particle (the colouring),
+// which is what the vectorise hint says.
+template <class Kernel>
 [[gnu::noinline, gnu::flatten]] void project_range(
     size_t begin, size_t end, const Index* __restrict ci, const Index* __restrict cj,
     const double* __restrict ks, const double* __restrict kd, const double* __restrict l0,
     const double* __restrict inv_m, double* __restrict x, Index nx, const double* __restrict old,
-    Index no, double h, double* __restrict lambda, bool keep_lambda) {
+    Index no, double h, double* __restrict lambda, bool keep_lambda, Kernel kernel) {
   // Not in a WebAssembly module (engine/web/): its SIMD has no gathers, and the link-time
   // optimiser there reports a hinted loop it does not vectorise.
 #if !defined(__wasm__)
@@ -36,9 +56,9 @@ namespace {
   for (size_t c = begin; c < end; ++c) {
     const Index i = ci[c], j = cj[c];
     Vec3 x_i(x[i], x[nx + i], x[2 * nx + i]), x_j(x[j], x[nx + j], x[2 * nx + j]);
-    const double delta_lambda = xpbd_project(x_i, x_j, Vec3(old[i], old[no + i], old[2 * no + i]),
-                                             Vec3(old[j], old[no + j], old[2 * no + j]), inv_m[i],
-                                             inv_m[j], ks[c], kd[c], l0[c], h, lambda[c]);
+    const double delta_lambda = kernel(x_i, x_j, Vec3(old[i], old[no + i], old[2 * no + i]),
+                                       Vec3(old[j], old[no + j], old[2 * no + j]), inv_m[i],
+                                       inv_m[j], ks[c], kd[c], l0[c], h, lambda[c]);
     x[i] = x_i.x();
     x[nx + i] = x_i.y();
     x[2 * nx + i] = x_i.z();
@@ -52,31 +72,32 @@ namespace {
 #endif
 }
 
-}  // namespace
-
-bool FastEngine::xpbd_project(World& world, const XpbdConstraints& constraints,
-                              const Matrix3X& x_old, double h, int iterations, bool keep_lambda,
-                              std::vector<double>& lambda) {
+// `iterations` passes of `kernel` over the constraints, colour by colour, each colour split over
+// the threads when it has xpbd_split constraints or more; x and x_old in the fast layout (xs,
+// olds) for the passes, x copied back after them.
+template <class Kernel>
+void colour_passes(World& world, const XpbdConstraints& cs, const Matrix3X& x_old, double h,
+                   int iterations, bool keep_lambda, std::vector<double>& lambda, SoA3& xs,
+                   SoA3& olds, Index split, Kernel kernel) {
   Particles& p = world.particles;
   const Index n = p.size();
-  xpbd_x_.resize(3, Copies::padded(n, 21));
-  xpbd_old_.resize(3, Copies::padded(n, 7));
-  const Index nx = xpbd_x_.cols(), no = xpbd_old_.cols();
+  xs.resize(3, Copies::padded(n, 21));
+  olds.resize(3, Copies::padded(n, 7));
+  const Index nx = xs.cols(), no = olds.cols();
   world.for_particles([&](Index begin, Index end) {
-    to_soa(begin, end, p.x.data(), xpbd_x_.data(), nx);
-    to_soa(begin, end, x_old.data(), xpbd_old_.data(), no);
+    to_soa(begin, end, p.x.data(), xs.data(), nx);
+    to_soa(begin, end, x_old.data(), olds.data(), no);
   });
-  const XpbdConstraints& cs = constraints;
   const auto project = [&](size_t begin, size_t end) {
     project_range(begin, end, cs.i.data(), cs.j.data(), cs.ks.data(), cs.kd.data(), cs.l0.data(),
-                  p.inv_m.data(), xpbd_x_.data(), nx, xpbd_old_.data(), no, h, lambda.data(),
-                  keep_lambda);
+                  p.inv_m.data(), xs.data(), nx, olds.data(), no, h, lambda.data(), keep_lambda,
+                  kernel);
   };
   for (int it = 0; it < iterations; ++it) {
     for (int q = 0; q < cs.colours(); ++q) {
       const size_t first = cs.colour_start[static_cast<size_t>(q)];
       const size_t count = cs.colour_start[static_cast<size_t>(q) + 1] - first;
-      if (world.threads <= 1 || count < static_cast<size_t>(std::max<Index>(xpbd_split, 1))) {
+      if (world.threads <= 1 || count < static_cast<size_t>(std::max<Index>(split, 1))) {
         project(first, first + count);
         continue;
       }
@@ -86,8 +107,24 @@ bool FastEngine::xpbd_project(World& world, const XpbdConstraints& constraints,
     }
   }
   world.for_particles(
-      [&](Index begin, Index end) { from_soa(begin, end, xpbd_x_.data(), nx, p.x.data()); });
+      [&](Index begin, Index end) { from_soa(begin, end, xs.data(), nx, p.x.data()); });
+}
+
+}  // namespace
+
+bool FastEngine::xpbd_project(World& world, const XpbdConstraints& constraints,
+                              const Matrix3X& x_old, double h, int iterations, bool keep_lambda,
+                              std::vector<double>& lambda) {
+  colour_passes(world, constraints, x_old, h, iterations, keep_lambda, lambda, xpbd_x_, xpbd_old_,
+                xpbd_split, [](auto&&... a) { return clothlab::xpbd_project(a...); });
   return true;
+}
+
+void FastEngine::xpbd_access_passes(World& world, const XpbdConstraints& constraints,
+                                    const Matrix3X& x_old, double h, int iterations,
+                                    std::vector<double>& lambda) {
+  colour_passes(world, constraints, x_old, h, iterations, true, lambda, xpbd_x_, xpbd_old_,
+                xpbd_split, [](auto&&... a) { return access_only(a...); });
 }
 
 }  // namespace clothlab::fast

@@ -3,7 +3,8 @@
 # itself at half its step is below every stable method's error (the reference has converged), and
 # symplectic Euler's error falls as its step falls; the plot script is written, and the plot drawn
 # when matplotlib is there. Its timings are never checked. Then `--speed` on a small grid writes
-# its CSV.
+# its CSV, with VBD's readable rows (positive figures), and prints the measured bound on an XPBD
+# iteration (positive figures).
 cmake_policy(VERSION 3.22)  # quoted strings are strings, never variables' names (CMP0054)
 include(${CMAKE_CURRENT_LIST_DIR}/cli_bench_checks.cmake)
 file(REMOVE_RECURSE ${WORK})
@@ -70,22 +71,43 @@ run_bench("bench methods --speed" bench methods --quick --no-plot --min-seconds 
 file(STRINGS ${WORK}/speed/speed.csv speed)
 list(LENGTH speed count)
 list(GET speed 0 header)
-# Five measures, readable and engine room, on 1 and 2 threads: twenty rows.
-if(NOT count EQUAL 21 OR NOT header STREQUAL "grid,springs,measure,ns_per_spring,threads")
-  message(FATAL_ERROR "speed.csv is not a header and twenty rows:\n${speed}")
+# Five measures, readable and engine room, and VBD's two readable ones, on 1 and 2 threads:
+# twenty-four rows.
+if(NOT count EQUAL 25 OR NOT header STREQUAL "grid,springs,measure,ns_per_spring,threads")
+  message(FATAL_ERROR "speed.csv is not a header and twenty-four rows:\n${speed}")
 endif()
+# A positive figure: a nonzero digit, no sign (an iteration is a difference of two timings, but
+# VBD's eight extra sweeps and the bound's eight extra passes cost far more than the noise).
+set(positive "[0-9.]*[1-9][0-9.]*(e[-+][0-9]+)?")
 foreach(row "16,[0-9]+,xpbd-iteration,[-0-9.e]+,1" "16,[0-9]+,xpbd-iteration-readable,[-0-9.e]+,2"
         "16,[0-9]+,symplectic-euler-step,[0-9.e-]+,2"
         "16,[0-9]+,implicit-euler-cg-iteration,[0-9.e-]+,1"
         "16,[0-9]+,implicit-euler-cg-iteration-readable,[0-9.e-]+,2"
         "16,[0-9]+,local-global-iteration,[-0-9.e]+,2"
-        "16,[0-9]+,local-global-iteration-readable,[-0-9.e]+,1")
+        "16,[0-9]+,local-global-iteration-readable,[-0-9.e]+,1"
+        "16,[0-9]+,vbd-step-1-iteration-readable,${positive},1"
+        "16,[0-9]+,vbd-iteration-readable,${positive},1"
+        "16,[0-9]+,vbd-step-1-iteration-readable,${positive},2"
+        "16,[0-9]+,vbd-iteration-readable,${positive},2")
   set(found ${speed})
   list(FILTER found INCLUDE REGEX "^${row}$")
   if(NOT found)
     message(FATAL_ERROR "speed.csv has no row like ${row}:\n${speed}")
   endif()
 endforeach()
+# The bound on an XPBD iteration, measured in the same run, and VBD's printed row.
+string(CONCAT bound "16 x 16: XPBD iteration / Euler step = [0-9.]+ [^\n]*\n    bound: the "
+       "iteration's passes with no square root or division [^\n]* take ${positive} ns per "
+       "spring on 1 thread, ${positive} Euler steps; ${positive} on 2 threads; the XPBD "
+       "iteration is ${positive} times them\n")
+if(NOT out MATCHES "${bound}")
+  message(FATAL_ERROR "bench methods --speed printed no positive bound on an XPBD iteration:\n${out}")
+endif()
+string(CONCAT vbd "VBD \\(lesson 14\\)[^\n]*\n[^\n]*\n[^\n]*\n +16 x 16 +1 \\| +${positive} "
+       "\\| +${positive} +${positive} \\| +${positive} \\| +${positive}\n")
+if(NOT out MATCHES "${vbd}")
+  message(FATAL_ERROR "bench methods --speed printed no VBD row with positive figures:\n${out}")
+endif()
 file(STRINGS ${WORK}/speed/methods.csv lines)
 list(LENGTH lines count)
 math(EXPR expected "${rows_per_scene} + 1")
