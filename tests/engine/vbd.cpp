@@ -501,6 +501,9 @@ TEST_CASE("vbd: the fast path takes no whole step and no force sum, with the sam
 
 TEST_CASE("vbd: the game loop drives a scene the same for any split into frames") {
   test::check_frames_do_not_matter(test::storm() + "method = \"vbd\"\niterations = 2\n");
+  // The adaptive guess keeps the last step's velocities: a frame's split must not lose them.
+  test::check_frames_do_not_matter(
+      test::storm() + "method = \"vbd\"\niterations = 2\ninitial_guess = \"adaptive\"\n");
 }
 
 // ---- The colouring ---------------------------------------------------------------------------

@@ -124,8 +124,8 @@ void Vbd::advance(World& world, double dt) {
     ++graph_builds;
   }
 
-  // y = x_n + h v_n + h^2 M^-1 f_ext, and the initial guess x = y. A pinned vertex (inv_m = 0)
-  // moves by h v_n, its pin's velocity, and stays there.
+  // y = x_n + h v_n + h^2 M^-1 f_ext, and the initial guess x = y (or the adaptive guess,
+  // vbd.hpp). A pinned vertex (inv_m = 0) moves by h v_n, its pin's velocity, and stays there.
   x_n_ = p.x;
   y_.resize(3, n);
   for (Index i = 0; i < n; ++i)

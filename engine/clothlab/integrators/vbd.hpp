@@ -18,6 +18,7 @@
 //           game's push, ...): explicit, as in XPBD and the local/global solver
 //   y     = x_n + h v_n + h^2 M^-1 f_ext       where inertia and the external forces carry x
 //   x     = y                                  the initial guess: inertia and f_ext, no springs
+//                                              (initial_guess = "adaptive": see below)
 //   repeat `iterations` times:
 //     for each colour, for each free vertex i of that colour:   x_i += vbd_vertex_step(...)
 //   v     = (x - x_n) / h                      implicit Euler's velocity
