@@ -42,8 +42,11 @@
 //
 // Stopped early, the step is not implicit Euler's, and it can gain energy: this is the method,
 // not a flaw of this code. The vertex force and Hessian are G_i's derivatives (checked by finite
-// differences in tests/engine/vbd.cpp); the figures below are the same without dampers (kd = 0)
-// and with the vertices swept in index order instead of by colour; and with the sweeps converged
+// differences in tests/engine/vbd.cpp). In the run measured below, 20 steps of 1, 10 and 100
+// iterations end at 291 J, 189 J and 60.5 J; without dampers (kd = 0) at 291 J, 189 J and 60.4
+// J; with the vertices swept in index order instead of by colour at 288 J, 188 J and 60.2 J;
+// without the clamp on a compressed spring's Hessian (as the paper's reference code has it)
+// worse, at 303 J, 261 J and 60340 J; and with the sweeps converged
 // (1000 iterations) the step loses energy as implicit Euler does. The cause is Gauss-Seidel far
 // from converged: here m/h^2 = 0.88 N/m per vertex against ks = 1000 N/m, so a vertex step
 // follows its neighbours and barely its inertia, and a sweep carries a pin's pull only a vertex
