@@ -40,21 +40,21 @@
 // not dropped. Without a last step (the first) a is taken as 0, where the paper's code takes y.
 // Only the guess changes: y, in G, still carries every external force.
 //
-// Stopped early, the step is not implicit Euler's, and it can gain energy: this is the method,
-// not a flaw of this code. The vertex force and Hessian are G_i's derivatives (checked by finite
+// Stopped early, the step is not implicit Euler's, and it can gain energy: this is the method, not
+// a flaw of this code. The vertex force and Hessian are G_i's derivatives (checked by finite
 // differences in tests/engine/vbd.cpp). In the run measured below, 20 steps of 1, 10 and 100
-// iterations end at 291 J, 189 J and 60.5 J; without dampers (kd = 0) at 291 J, 189 J and 60.4
-// J; with the vertices swept in index order instead of by colour at 288 J, 188 J and 60.2 J;
-// without the clamp on a compressed spring's Hessian (as the paper's reference code has it)
-// worse, at 303 J, 261 J and 60340 J; and with the sweeps converged
-// (1000 iterations) the step loses energy as implicit Euler does. The cause is Gauss-Seidel far
-// from converged: here m/h^2 = 0.88 N/m per vertex against ks = 1000 N/m, so a vertex step
-// follows its neighbours and barely its inertia, and a sweep carries a pin's pull only a vertex
-// or two further. From y the cloth below the top rows falls as if it were not pinned, and the
-// springs between stretch, their energy bought from nothing. Measured with `clothlab run` on a
-// 64 x 64 cloth (2 cm apart, its top row at y = 1 m, 1 kg in all, ks = 1000 N/m, kd = 0.01 N
-// s/m, gravity, top corners pinned; the scene of the test "a hanging cloth stepped with few
-// iterations ...") at 1/60 s, total energy [J], starting at 3.63 J (a blank: not measured):
+// iterations end at 291 J, 189 J and 60.5 J; without dampers (kd = 0) at 291 J, 189 J and 60.4 J;
+// with the vertices swept in index order instead of by colour at 288 J, 188 J and 60.2 J; without
+// the clamp on a compressed spring's Hessian (as the paper's reference code has it) worse, at
+// 303 J, 261 J and 60340 J; and with the sweeps converged (1000 iterations) the step loses energy
+// as implicit Euler does. The cause is Gauss-Seidel far from converged: here m/h^2 = 0.88 N/m per
+// vertex against ks = 1000 N/m, so a vertex step follows its neighbours and barely its inertia, and
+// a sweep carries a pin's pull only a vertex or two further. From y the cloth below the top rows
+// falls as if it were not pinned, and the springs between stretch, their energy bought from
+// nothing. Measured with `clothlab run` on a 64 x 64 cloth (2 cm apart, its top row at y = 1 m,
+// 1 kg in all, ks = 1000 N/m, kd = 0.01 N s/m, gravity, top corners pinned; the scene of the test
+// "a hanging cloth stepped with few iterations ...") at 1/60 s, total energy [J], starting at
+// 3.63 J (a blank: not measured):
 //
 //   iterations                         1       10      100     1000
 //   20 steps, initial_guess "inertia"  291     189     60.5    3.59
