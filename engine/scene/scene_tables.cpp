@@ -896,8 +896,18 @@ void read_integrator(SceneTable& t, Scene& scene) {
     local_global->iterations =
         static_cast<int>(t.integer("iterations", 1, 10'000, local_global->iterations));
   }
-  if (auto* vbd = dynamic_cast<Vbd*>(scene.world.integrator.get()))
+  if (method != "vbd" && t.has("initial_guess")) {
+    t.fail("initial_guess",
+           fmt::format("initial_guess sets where the iterations of method = \"vbd\" (lesson 14) "
+                       "start, but method is \"{}\"; expected no initial_guess here",
+                       method));
+  }
+  if (auto* vbd = dynamic_cast<Vbd*>(scene.world.integrator.get())) {
     vbd->iterations = static_cast<int>(t.integer("iterations", 1, 10'000, vbd->iterations));
+    vbd->initial_guess = t.choice("initial_guess", {"inertia", "adaptive"}, "inertia") == "adaptive"
+                             ? VbdInitialGuess::adaptive
+                             : VbdInitialGuess::inertia;
+  }
   // The linear solver of the implicit method; another method has none to tune.
   for (const char* key : {"tolerance", "max_iterations"}) {
     if (method != "implicit-euler" && t.has(key)) {
@@ -1011,7 +1021,7 @@ constexpr std::array kKinds = {
     SceneTableKind{"tearing", false, false, "strain max_per_step", "[tearing] with strain",
                    read_tearing, "strain"},
     SceneTableKind{"integrator", false, true,
-                   "method dt duration tolerance max_iterations substeps iterations",
+                   "method dt duration tolerance max_iterations substeps iterations initial_guess",
                    "[integrator] with method, dt [s] and duration [s]", read_integrator},
     SceneTableKind{"output", false, false, "fps velocities springs format", "[output] with fps",
                    read_output},

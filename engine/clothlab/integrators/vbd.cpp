@@ -5,6 +5,7 @@
 
 #include "clothlab/core/stop.hpp"
 #include "clothlab/core/world.hpp"
+#include "clothlab/forces/gravity.hpp"
 #include "clothlab/forces/spring_damper.hpp"
 
 namespace clothlab {
@@ -74,6 +75,24 @@ void VbdGraph::build(Index particles, const std::vector<const SpringSet*>& famil
     order[fill[static_cast<size_t>(colour[i])]++] = static_cast<Index>(i);
 }
 
+void Vbd::adaptive_guess(Particles& p, const Vec3& g, double h) {
+  // x = x_n + h v_n + h^2 a g/|g|, a = the last step's acceleration along g, clamped to [0, |g|]
+  // (vbd.hpp). Without a last step (the first, or the particles changed) a is taken as 0.
+  const Index n = p.size();
+  const double g_norm = g.norm();
+  const bool have_last = v_previous_.cols() == n && g_norm > 0.0;
+  for (Index i = 0; i < n; ++i) {
+    if (p.inv_m[i] == 0.0) continue;  // a pin goes where its velocity takes it, as in y
+    double a = 0.0;
+    if (have_last) {
+      a = (p.v.col(i) - v_previous_.col(i)).dot(g) / (h * g_norm);
+      a = std::clamp(a, 0.0, g_norm);
+    }
+    p.x.col(i) = x_n_.col(i) + h * p.v.col(i);
+    if (a > 0.0) p.x.col(i) += (h * h * a / g_norm) * g;
+  }
+}
+
 void Vbd::advance(World& world, double dt) {
   Particles& p = world.particles;
   const Index n = p.size();
@@ -84,6 +103,7 @@ void Vbd::advance(World& world, double dt) {
   // graph is built again when a set's ends or constants change (SpringSet::version).
   std::vector<const SpringSet*> families;
   std::vector<unsigned long> versions;
+  Vec3 gravity_g = Vec3::Zero();  // gravity's acceleration, for the adaptive initial guess
   f_ext_.setZero(3, n);
   ++world.force_evaluations;  // one sum of the external forces a step (reports)
   for (const auto& effect : world.force_effects) {
@@ -91,6 +111,8 @@ void Vbd::advance(World& world, double dt) {
       families.push_back(&springs->springs());
       versions.push_back(springs->springs().version());
     } else {
+      if (const auto* gravity = dynamic_cast<const UniformGravity*>(effect.get()))
+        gravity_g += gravity->g();
       effect->add_forces(p, p.x, p.v, f_ext_);
     }
   }
@@ -102,13 +124,14 @@ void Vbd::advance(World& world, double dt) {
     ++graph_builds;
   }
 
-  // y = x_n + h v_n + h^2 M^-1 f_ext, and the initial guess x = y. A pinned vertex (inv_m = 0)
-  // moves by h v_n, its pin's velocity, and stays there.
+  // y = x_n + h v_n + h^2 M^-1 f_ext, and the initial guess x = y (or the adaptive guess,
+  // vbd.hpp). A pinned vertex (inv_m = 0) moves by h v_n, its pin's velocity, and stays there.
   x_n_ = p.x;
   y_.resize(3, n);
   for (Index i = 0; i < n; ++i)
     y_.col(i) = x_n_.col(i) + h * p.v.col(i) + (h * h * p.inv_m[i]) * f_ext_.col(i);
   p.x = y_;
+  if (initial_guess == VbdInitialGuess::adaptive) adaptive_guess(p, gravity_g, h);
 
   // The sweeps: colour by colour, each free vertex one Newton step with its neighbours where
   // they are now (Gauss-Seidel). The rest lengths are read each time (plasticity changes them).
@@ -133,6 +156,7 @@ void Vbd::advance(World& world, double dt) {
   }
 
   // Implicit Euler's velocity, v = (x - x_n) / h; a pinned vertex keeps its pin's velocity.
+  v_previous_ = p.v;  // v_n, for the next step's adaptive guess
   for (Index i = 0; i < n; ++i) {
     if (p.inv_m[i] != 0.0) p.v.col(i) = (p.x.col(i) - x_n_.col(i)) / h;
   }
