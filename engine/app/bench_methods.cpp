@@ -2,12 +2,12 @@
 //
 // Each scene runs under every method over a ladder of settings: symplectic Euler and RK4 from
 // the largest step the stability advisor allows (lesson 08) down, implicit Euler from one step a
-// frame down, XPBD at one step a frame with more and more substeps or iterations, and the
-// local/global solver when the engine has it. Every run is compared, frame by frame, with a
-// reference of the same spring model: RK4 at a step far below its stability limit. The
-// reference is run twice, at dt_ref and dt_ref / 2, and the difference between the two is
-// printed beside the methods' errors: the reference has converged where that difference is far
-// below them.
+// frame down, XPBD at one step a frame with more and more substeps or iterations, the
+// local/global solver, and Vertex Block Descent (lesson 14) at one sweep a step and ten. Every run
+// is compared, frame by frame, with a reference of the same spring model: RK4 at a step far below
+// its stability limit. The reference is run twice, at dt_ref and dt_ref / 2, and the difference
+// between the two is printed beside the methods' errors: the reference has converged where that
+// difference is far below them.
 //
 // For each run: the error (the particles' root-mean-square distance from the reference over
 // all frames, relative to the cloth's size), the worst strain |l - l0| / l0 of a structural or
@@ -22,7 +22,8 @@
 // run, and the targets beside the ratios. Beside each target, what bounds it, measured in
 // the same run: for an XPBD iteration, the engine room's same passes with no square root or
 // division (FastEngine::xpbd_access_passes: the gathers and scatters alone); for local/global,
-// its solve alone.
+// its solve alone; for two threads, the wakes of the threads (barriers) a step or an iteration
+// makes, counted, at the cost of a wake with nothing to do, and a stream's own speed-up.
 //
 // Implicit Euler's rows: ns per spring per conjugate-gradient iteration, readable and engine
 // room, with the iterations per step, and a streaming pass over as many bytes as the bound.
@@ -109,7 +110,8 @@ std::vector<Ladder> ladders(bool quick, bool large) {
     return {{"symplectic-euler", true, {1}},
             {"implicit-euler", false, {1}},
             {"xpbd", false, {1}, {{4, 1}}},
-            {"local-global", false, {1}, {{0, 10}}}};
+            {"local-global", false, {1}, {{0, 10}}},
+            {"vbd", false, {1}, {{0, 1}}}};
   }
   if (large) {
     // A cloth of real size at a game's frame: the explicit methods need hundreds of steps a
@@ -120,7 +122,8 @@ std::vector<Ladder> ladders(bool quick, bool large) {
             {"implicit-euler", false, {1, 4, 16}},
             {"xpbd", false, {1}, {{1, 1}, {4, 1}, {16, 1}, {64, 1}, {1, 16}}},
             {"xpbd", false, {8}, {{8, 1}}},
-            {"local-global", false, {1, 4, 16}, {{0, 10}}}};
+            {"local-global", false, {1, 4, 16}, {{0, 10}}},
+            {"vbd", false, {1, 4, 16}, {{0, 1}, {0, 10}}}};
   }
   if (quick) {
     return {{"symplectic-euler", true, {1, 2, 4}},
@@ -128,7 +131,8 @@ std::vector<Ladder> ladders(bool quick, bool large) {
             {"implicit-euler", false, {1, 4, 16}},
             {"xpbd", false, {1}, {{1, 1}, {8, 1}, {64, 1}, {1, 8}}},
             {"xpbd", false, {8}, {{8, 1}}},
-            {"local-global", false, {1, 4}, {{0, 10}}}};
+            {"local-global", false, {1, 4}, {{0, 10}}},
+            {"vbd", false, {1, 4}, {{0, 10}}}};
   }
   // Symplectic Euler's first rung takes twice the advised step, to show where it fails.
   return {
@@ -139,7 +143,9 @@ std::vector<Ladder> ladders(bool quick, bool large) {
       // 64 substeps a frame again, in 8 steps of 8: colliders act after every substep either
       // way (world.hpp's substep contract); the effects that act once a step see 8 steps.
       {"xpbd", false, {8}, {{8, 1}}},
-      {"local-global", false, {1, 2, 4, 8, 16}, {{0, 10}}}};
+      {"local-global", false, {1, 2, 4, 8, 16}, {{0, 10}}},
+      // Vertex Block Descent (lesson 14): one sweep a step, and ten.
+      {"vbd", false, {1, 2, 4, 8, 16}, {{0, 1}, {0, 10}}}};
 }
 
 bool engine_has(std::string_view method) {
@@ -478,6 +484,66 @@ double xpbd_access_ns(const std::string& text, size_t springs, int steps, int re
   return 1e9 * (many - one) / (static_cast<double>(springs) * steps * more);
 }
 
+// The times a step wakes the threads, on `threads` threads in the engine room (ThreadTeam::run:
+// each hands every thread a job and waits for all of them, a barrier), per step after a first.
+double wakes_per_step(const std::string& text, int threads, int steps) {
+  World world = std::move(parse_scene(text, "<speed>").world);
+  world.threads = threads;
+  world.step(1e-4);
+  const long before = world.thread_wakes();
+  for (int s = 0; s < steps; ++s)
+    world.step(1e-4);
+  return static_cast<double>(world.thread_wakes() - before) / steps;
+}
+
+// What one wake of `threads` threads costs with nothing to do [ns]: ThreadTeam::run of an empty
+// job, the fastest of 5 runs of 20000.
+double wake_ns(int threads) {
+  ThreadTeam team(threads);
+  constexpr int kWakes = 20000;
+  double best = std::numeric_limits<double>::infinity();
+  for (int r = 0; r < 5; ++r) {
+    const Clock::time_point start = Clock::now();
+    for (int w = 0; w < kWakes; ++w)
+      team.run([](int) {});
+    best = std::min(best, std::chrono::duration<double>(Clock::now() - start).count());
+  }
+  return 1e9 * best / kWakes;
+}
+
+// One pass of a loop of square roots and divisions alone over `n` values (kept out of line, so
+// that the passes are not turned inside out into one chain per value).
+[[gnu::noinline]] void sqrt_div_pass(double* v, int n) {
+  for (int i = 0; i < n; ++i)
+    v[i] = 1.7 / std::sqrt(v[i]);
+}
+
+// What `threads` threads gain over one on square roots and divisions alone, the step's slowest
+// instructions: each thread runs the same passes over its own values in the first-level cache;
+// the work done per second by all at once against one alone, fastest of 5. A virtual machine's
+// cores may share a physical core, and then this is below `threads`.
+double arithmetic_gain(int threads) {
+  constexpr int kValues = 512, kPasses = 10000;
+  ThreadTeam team(threads);
+  std::vector<std::vector<double>> values(static_cast<size_t>(threads),
+                                          std::vector<double>(kValues, 1.3));
+  const auto seconds = [&](int running) {
+    double best = std::numeric_limits<double>::infinity();
+    for (int r = 0; r < 5; ++r) {
+      const Clock::time_point start = Clock::now();
+      team.run([&](int t) {
+        if (t >= running) return;
+        for (int p = 0; p < kPasses; ++p)
+          sqrt_div_pass(values[static_cast<size_t>(t)].data(), kValues);
+      });
+      best = std::min(best, std::chrono::duration<double>(Clock::now() - start).count());
+    }
+    return best;
+  };
+  const double one = seconds(1);
+  return threads * one / seconds(threads);
+}
+
 // The extra iterations whose cost is the cost of an iteration (XPBD's, VBD's, the bound's).
 constexpr int kSpeedMore = 8;
 
@@ -488,6 +554,9 @@ struct SpeedRow {
   double euler[2] = {}, xpbd_one[2] = {}, xpbd_iteration[2] = {};  // [readable, engine room]
   // The XPBD iteration's passes with no square root or division (xpbd_access_ns): its bound.
   double xpbd_access = 0.0;
+  // On more than one thread: the wakes of the threads a symplectic Euler step and an XPBD
+  // iteration make (wakes_per_step), and what one wake costs [ns] (wake_ns).
+  double euler_wakes = 0.0, xpbd_wakes = 0.0, wake = 0.0;
   // Vertex Block Descent (lesson 14), readable only: a step of one iteration and an iteration.
   double vbd_one = 0.0, vbd_iteration = 0.0;
 
@@ -557,6 +626,13 @@ SpeedRow measure_speed(int grid, int threads, bool quick) {
     if (fast == 1) {
       row.xpbd_access = xpbd_access_ns(speed_scene(grid, "xpbd", 1, 1), row.springs, steps, repeats,
                                        threads, kSpeedMore);
+      if (threads > 1) {
+        row.euler_wakes = wakes_per_step(speed_scene(grid, "symplectic-euler", 0, 0), threads, 4);
+        row.xpbd_wakes = (wakes_per_step(speed_scene(grid, "xpbd", 1, 1 + kSpeedMore), threads, 4) -
+                          wakes_per_step(speed_scene(grid, "xpbd", 1, 1), threads, 4)) /
+                         kSpeedMore;
+        row.wake = wake_ns(threads);
+      }
     } else {  // VBD has no engine room: its readable loop alone
       row.vbd_one = time(speed_scene(grid, "vbd", 0, 1));
       row.vbd_iteration =
@@ -621,6 +697,22 @@ void speed(const MethodsOptions& opt, const fs::path& out_dir) {
                    xpbd = one.xpbd_iteration[1] / two.xpbd_iteration[1];
       fmt::print("; 2 threads over 1: Euler {:.2f}, XPBD {:.2f}{}", euler, xpbd,
                  one.grid == 128 ? (euler >= 1.7 && xpbd >= 1.7 ? " (met)" : " (missed)") : "");
+      // What bounds two threads: the wakes (each a barrier) a step or an iteration makes, at
+      // their measured cost with nothing to do, and the memory's own speed-up (a stream).
+      const double springs = static_cast<double>(one.springs);
+      const auto most = [&](double ns_per_spring, double wakes) {
+        const double t1 = ns_per_spring * springs;
+        return t1 / (t1 / 2 + wakes * two.wake);
+      };
+      fmt::print(
+          "\n    bound on 2 threads: an Euler step wakes the threads {:.1f} times, an XPBD "
+          "iteration {:.1f}, at {:.0f} ns a wake with nothing to do: with the rest split evenly, "
+          "at most {:.2f} and {:.2f} times 1 thread; on this machine a stream gains {:.2f} and "
+          "square roots and divisions alone {:.2f}",
+          two.euler_wakes, two.xpbd_wakes, two.wake, most(one.euler[1], two.euler_wakes),
+          most(one.xpbd_iteration[1], two.xpbd_wakes),
+          streaming_ns_per_spring(one.springs, 1) / streaming_ns_per_spring(one.springs, 2),
+          arithmetic_gain(2));
     }
     fmt::print("\n");
     // What bounds it: the same passes, gathers and scatters with no square root or division.

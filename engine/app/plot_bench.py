@@ -46,11 +46,15 @@ METHODS_STYLE = {
     "xpbd iterations": ("tab:olive", "^"),
     "xpbd steps x substeps": ("tab:cyan", "*"),
     "local-global": ("tab:purple", "v"),
+    "vbd 1 iteration": ("tab:gray", "X"),
+    "vbd 10 iterations": ("black", "p"),
 }
 
 def line_name(row):
     """XPBD's rungs that add substeps, those that add iterations, and those that take several
     steps a frame (so that the colliders act more often) are three lines."""
+    if row["method"] == "vbd":
+        return "vbd 1 iteration" if int(row["iterations"]) == 1 else "vbd 10 iterations"
     if row["method"] != "xpbd":
         return row["method"]
     if float(row["dt"]) < 0.99 / 60.0:

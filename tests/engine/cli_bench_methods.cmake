@@ -4,15 +4,15 @@
 # symplectic Euler's error falls as its step falls; the plot script is written, and the plot drawn
 # when matplotlib is there. Its timings are never checked. Then `--speed` on a small grid writes
 # its CSV, with VBD's readable rows (positive figures), and prints the measured bound on an XPBD
-# iteration (positive figures).
+# iteration and on two threads (positive figures).
 cmake_policy(VERSION 3.22)  # quoted strings are strings, never variables' names (CMP0054)
 include(${CMAKE_CURRENT_LIST_DIR}/cli_bench_checks.cmake)
 file(REMOVE_RECURSE ${WORK})
 file(MAKE_DIRECTORY ${WORK})
 run_bench("bench methods" bench methods --quick --min-seconds 0.001 --out out)
 # Per scene, in --quick: the reference, symplectic Euler x 3 steps, RK4 x 2, implicit Euler x 3,
-# XPBD x 5 settings, and the local/global solver x 2 when the engine has it.
-read_methods_csv(${WORK}/out/methods.csv 14 16)
+# XPBD x 5 settings, VBD x 2, and the local/global solver x 2 when the engine has it.
+read_methods_csv(${WORK}/out/methods.csv 16 18)
 foreach(scene bakeoff-hanging-sheet bakeoff-gusty-flag bakeoff-drape)
   set(rows 0)
   set(self_difference "")
@@ -96,12 +96,24 @@ foreach(row "16,[0-9]+,xpbd-iteration,[-0-9.e]+,1" "16,[0-9]+,xpbd-iteration-rea
   endif()
 endforeach()
 # The bound on an XPBD iteration, measured in the same run, and VBD's printed row.
-string(CONCAT bound "16 x 16: XPBD iteration / Euler step = [0-9.]+ [^\n]*\n    bound: the "
+string(CONCAT bound "16 x 16: XPBD iteration / Euler step = [0-9.]+ [^\n]*\n"
+       "(    bound on 2 threads[^\n]*\n)?    bound: the "
        "iteration's passes with no square root or division [^\n]* take ${positive} ns per "
        "spring on 1 thread, ${positive} Euler steps; ${positive} on 2 threads; the XPBD "
        "iteration is ${positive} times them\n")
 if(NOT out MATCHES "${bound}")
   message(FATAL_ERROR "bench methods --speed printed no positive bound on an XPBD iteration:\n${out}")
+endif()
+# What bounds two threads, measured in the same run: the wakes of the threads counted, their
+# cost, the speed-ups they allow, and this machine's own for a stream and for arithmetic. (On a
+# 16 x 16 grid an XPBD iteration wakes none: no colour is large enough to split.)
+string(CONCAT two_bound "2 threads over 1: Euler ${positive}, XPBD ${positive}\n    bound on 2 "
+       "threads: an Euler step wakes the threads ${positive} times, an XPBD iteration "
+       "[0-9.]+, at ${positive} ns a wake with nothing to do: with the rest split evenly, "
+       "at most ${positive} and ${positive} times 1 thread; on this machine a stream gains "
+       "${positive} and square roots and divisions alone ${positive}\n")
+if(NOT out MATCHES "${two_bound}")
+  message(FATAL_ERROR "bench methods --speed printed no bound on two threads:\n${out}")
 endif()
 string(CONCAT vbd "VBD \\(lesson 14\\)[^\n]*\n[^\n]*\n[^\n]*\n +16 x 16 +1 \\| +${positive} "
        "\\| +${positive} +${positive} \\| +${positive} \\| +${positive}\n")

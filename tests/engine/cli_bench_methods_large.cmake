@@ -12,9 +12,9 @@ file(MAKE_DIRECTORY ${WORK})
 # The reference by symplectic Euler (the engine room's, the cheapest step), to check --reference.
 run_bench("bench methods --large --quick" bench methods --large --quick --no-plot
           --min-seconds 0.001 --reference symplectic-euler --out large)
-# Per scene: the reference, then one rung each of symplectic Euler, implicit Euler, XPBD, and
-# the local/global solver when the engine has it.
-read_methods_csv(${WORK}/large/methods.csv 4 5)
+# Per scene: the reference, then one rung each of symplectic Euler, implicit Euler, XPBD, VBD,
+# and the local/global solver when the engine has it.
+read_methods_csv(${WORK}/large/methods.csv 5 6)
 set(frames 1)  # --quick --large
 foreach(scene bakeoff-large-sheet bakeoff-large-flag bakeoff-large-drape)
   if(NOT out MATCHES "scene [^\n]*${scene}.toml: ${frames} frames[^\n]*\n[^\n]*\n[^\n]*\n  \

@@ -70,6 +70,7 @@ void ThreadTeam::record(std::exception_ptr error) {
 }
 
 void ThreadTeam::run(const std::function<void(int)>& job) {
+  ++runs_;
   if (size_ == 1) {
     job(0);
     return;

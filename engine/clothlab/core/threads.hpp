@@ -30,6 +30,10 @@ class ThreadTeam {
   // every one has returned. If jobs threw, the first exception is rethrown here.
   void run(const std::function<void(int)>& job);
 
+  // The jobs run() has been given so far: each wakes the threads once and waits for them all
+  // (a barrier), the cost a step pays per pass over the particles (bench methods --speed).
+  long runs() const { return runs_; }
+
   // The threads this machine can run at once (at least 1).
   static int hardware_threads();
 
@@ -39,6 +43,7 @@ class ThreadTeam {
   void record(std::exception_ptr error);
 
   int size_;
+  long runs_ = 0;
   const std::function<void(int)>* job_ = nullptr;
   std::atomic<unsigned> generation_{0};  // one more for every job handed out
   std::atomic<int> busy_{0};             // workers still running the current job

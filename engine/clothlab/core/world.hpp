@@ -91,6 +91,9 @@ class World {
   // "gravity, gravitation; symplectic-euler": what a report or an error names as in play.
   std::string effects_in_play() const;
 
+  // The times the steps so far have woken the threads (ThreadTeam::runs), 0 on one thread.
+  long thread_wakes() const { return team_ ? team_->runs() : 0; }
+
  private:
   ThreadTeam* team() const;  // the threads of a step, or null for one thread
 
