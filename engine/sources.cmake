@@ -53,7 +53,8 @@ set(CLOTHLAB_FAST_SOURCES
   fast/springs.cpp
   fast/aerodynamics.cpp
   fast/xpbd.cpp
-  fast/implicit.cpp)
+  fast/implicit.cpp
+  fast/vbd.cpp)
 # The engine room's parts that need CHOLMOD (libsuitesparse-dev): the native build only. The web
 # module (engine/web/) leaves them out and runs the lecture's local/global loop, on Eigen's solver.
 set(CLOTHLAB_FAST_CHOLMOD_SOURCES

@@ -28,9 +28,9 @@
 // Implicit Euler's rows: ns per spring per conjugate-gradient iteration, readable and engine
 // room, with the iterations per step, and a streaming pass over as many bytes as the bound.
 //
-// Vertex Block Descent's rows (lesson 14; readable only, it has no engine room): a step of one
-// iteration and an iteration, ns per spring and per vertex, against the engine room's symplectic
-// Euler step of the same run.
+// Vertex Block Descent's rows (lesson 14), readable and engine room: a step of one iteration and
+// an iteration, ns per spring and per vertex, against the engine room's symplectic Euler step of
+// the same run, and against an XPBD iteration.
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -557,8 +557,8 @@ struct SpeedRow {
   // On more than one thread: the wakes of the threads a symplectic Euler step and an XPBD
   // iteration make (wakes_per_step), and what one wake costs [ns] (wake_ns).
   double euler_wakes = 0.0, xpbd_wakes = 0.0, wake = 0.0;
-  // Vertex Block Descent (lesson 14), readable only: a step of one iteration and an iteration.
-  double vbd_one = 0.0, vbd_iteration = 0.0;
+  // Vertex Block Descent (lesson 14): a step of one iteration and an iteration.
+  double vbd_one[2] = {}, vbd_iteration[2] = {};  // [readable, engine room]
 
   // Implicit Euler: ns per spring per conjugate-gradient iteration, and iterations per step.
   double cg_iteration[2] = {}, cg_iterations[2] = {};
@@ -633,11 +633,10 @@ SpeedRow measure_speed(int grid, int threads, bool quick) {
                          kSpeedMore;
         row.wake = wake_ns(threads);
       }
-    } else {  // VBD has no engine room: its readable loop alone
-      row.vbd_one = time(speed_scene(grid, "vbd", 0, 1));
-      row.vbd_iteration =
-          (time(speed_scene(grid, "vbd", 0, 1 + kSpeedMore)) - row.vbd_one) / kSpeedMore;
     }
+    row.vbd_one[fast] = time(speed_scene(grid, "vbd", 0, 1));
+    row.vbd_iteration[fast] =
+        (time(speed_scene(grid, "vbd", 0, 1 + kSpeedMore)) - row.vbd_one[fast]) / kSpeedMore;
 
     // Implicit Euler at 1/600 s, a tenth of a frame: the solves time its iterations.
     const CgTiming cg = time_cg(speed_scene(grid, "implicit-euler", 0, 0), quick ? 2 : 6,
@@ -783,21 +782,24 @@ void speed(const MethodsOptions& opt, const fs::path& out_dir) {
         stream1, stream2, stream1 / stream2, one.cg_iteration[1] / stream1);
   }
 
-  // Vertex Block Descent, readable only.
+  // Vertex Block Descent.
   fmt::print(
-      "\n  VBD (lesson 14), readable only (no engine room): ns per spring and per vertex, an "
-      "iteration = (a step of {} iterations - a step of 1) / {}\n",
+      "\n  VBD (lesson 14): ns per spring, an iteration = (a step of {} iterations - a step of "
+      "1) / {}; per vertex = per spring x springs / vertices\n",
       1 + kSpeedMore, kSpeedMore);
-  fmt::print("  {:>9} {:>7} | {:>14} | {:>21} | {:>16} | {:>16}\n", "grid", "threads",
-             "step, 1 it.", "VBD iteration", "Euler step", "VBD it./Euler");
-  fmt::print("  {:>9} {:>7} | {:>14} | {:>10} {:>10} | {:>16} | {:>16}\n", "", "", "per spring",
-             "per spring", "per vertex", "engine, per vtx", "step (engine)");
+  fmt::print("  {:>9} {:>7} | {:>21} | {:>21} | {:>10} | {:>10} | {:>10}\n", "grid", "threads",
+             "step, 1 iteration", "VBD iteration", "engine,", "VBD it./", "VBD it./");
+  fmt::print("  {:>9} {:>7} | {:>10} {:>10} | {:>10} {:>10} | {:>10} | {:>10} | {:>10}\n", "", "",
+             "readable", "engine", "readable", "engine", "per vertex", "Euler step", "XPBD it.");
   for (const SpeedRow& r : rows) {
     const double vertices = static_cast<double>(r.grid) * r.grid;
     const double per_vertex = static_cast<double>(r.springs) / vertices;  // ns/spring -> ns/vertex
-    fmt::print("  {:>9} {:>7} | {:14.2f} | {:10.2f} {:10.2f} | {:16.2f} | {:16.2f}\n",
-               fmt::format("{0} x {0}", r.grid), r.threads, r.vbd_one, r.vbd_iteration,
-               r.vbd_iteration * per_vertex, r.euler[1] * per_vertex, r.vbd_iteration / r.euler[1]);
+    fmt::print(
+        "  {:>9} {:>7} | {:10.2f} {:10.2f} | {:10.2f} {:10.2f} | {:10.2f} | {:10.2f} | "
+        "{:10.2f}\n",
+        fmt::format("{0} x {0}", r.grid), r.threads, r.vbd_one[0], r.vbd_one[1], r.vbd_iteration[0],
+        r.vbd_iteration[1], r.vbd_iteration[1] * per_vertex, r.vbd_iteration[1] / r.euler[1],
+        r.vbd_iteration[1] / r.xpbd_iteration[1]);
   }
 
   std::string table = "grid,springs,measure,ns_per_spring,threads\n";
@@ -814,11 +816,9 @@ void speed(const MethodsOptions& opt, const fs::path& out_dir) {
 
       add("implicit-euler-cg-iteration", r.cg_iteration[fast]);
       add("local-global-iteration", r.lg_iteration[fast]);
+      add("vbd-step-1-iteration", r.vbd_one[fast]);
+      add("vbd-iteration", r.vbd_iteration[fast]);
     }
-    table += fmt::format("{},{},vbd-step-1-iteration-readable,{:.6g},{}\n", r.grid, r.springs,
-                         r.vbd_one, r.threads);
-    table += fmt::format("{},{},vbd-iteration-readable,{:.6g},{}\n", r.grid, r.springs,
-                         r.vbd_iteration, r.threads);
   }
   write_whole_file(out_dir / "speed.csv", table);
   fmt::print("  wrote {}\n", (out_dir / "speed.csv").string());

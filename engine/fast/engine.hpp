@@ -37,6 +37,9 @@
 //
 // Of a local/global step it takes the iterations (local_global.cpp): the local steps and
 // right-hand sides with the integrator's bits, the solves by CHOLMOD.
+//
+// Of a VBD step it takes the sweeps (vbd.cpp): colour by colour, each colour split over the
+// threads, with the bits of the integrator's own loop.
 #pragma once
 
 #include <functional>
@@ -82,6 +85,10 @@ class FastEngine final : public Backend {
   // value gives the same bits.
   Index xpbd_split = 2048;
 
+  // Vertex Block Descent's sweeps colour by colour (vbd.cpp): fewer vertices in a colour than
+  // this are stepped on one thread. Any value gives the same bits.
+  Index vbd_split = 1024;
+
   // Implicit Euler's conjugate gradients (implicit.cpp), preconditioned by the inverse of each
   // particle's 3x3 diagonal block of the matrix (block Jacobi), or of its diagonal alone (as
   // the lecture's solver is). SPEED.md measures what the blocks save.
@@ -102,6 +109,8 @@ class FastEngine final : public Backend {
                           double h, int iterations, std::vector<double>& lambda);
   bool implicit_euler_step(World& world, double dt, double tolerance, int max_iterations,
                            VectorX& dv, LinearSolveStats& stats) override;
+  bool vbd_sweeps(World& world, const VbdGraph& graph, const Matrix3X& x_n, const Matrix3X& y,
+                  double h, int iterations) override;
 #if defined(CLOTHLAB_CHOLMOD)
   // The local/global solver's iterations (local_global.cpp): the local step and the right-hand
   // side in the fast layout on the threads, the solve by CHOLMOD. Not in the web module, which
@@ -154,6 +163,12 @@ class FastEngine final : public Backend {
   std::vector<Contact> contacts_;
   Copies copies_;
   SoA3 xpbd_x_, xpbd_old_;  // x and x_old in the fast layout, for XPBD's projections
+  // VBD: the constants of every spring at every vertex, in the sweep's order (vbd.cpp).
+  struct VbdSpring {
+    Index other;        // the spring's other end
+    double ks, kd, l0;  // its constants this step
+  };
+  std::vector<VbdSpring> vbd_springs_;
   std::shared_ptr<ImplicitSolver> implicit_;  // implicit Euler's arrays (implicit.cpp)
   // The local/global solver's factor and buffers (local_global.cpp), made on its first step.
   std::shared_ptr<LocalGlobalRoom> local_global_;

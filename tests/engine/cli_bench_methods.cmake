@@ -3,8 +3,8 @@
 # itself at half its step is below every stable method's error (the reference has converged), and
 # symplectic Euler's error falls as its step falls; the plot script is written, and the plot drawn
 # when matplotlib is there. Its timings are never checked. Then `--speed` on a small grid writes
-# its CSV, with VBD's readable rows (positive figures), and prints the measured bound on an XPBD
-# iteration and on two threads (positive figures).
+# its CSV, with VBD's rows, readable and engine room (positive figures), and prints the measured
+# bound on an XPBD iteration and on two threads (positive figures).
 cmake_policy(VERSION 3.22)  # quoted strings are strings, never variables' names (CMP0054)
 include(${CMAKE_CURRENT_LIST_DIR}/cli_bench_checks.cmake)
 file(REMOVE_RECURSE ${WORK})
@@ -71,10 +71,10 @@ run_bench("bench methods --speed" bench methods --quick --no-plot --min-seconds 
 file(STRINGS ${WORK}/speed/speed.csv speed)
 list(LENGTH speed count)
 list(GET speed 0 header)
-# Five measures, readable and engine room, and VBD's two readable ones, on 1 and 2 threads:
-# twenty-four rows.
-if(NOT count EQUAL 25 OR NOT header STREQUAL "grid,springs,measure,ns_per_spring,threads")
-  message(FATAL_ERROR "speed.csv is not a header and twenty-four rows:\n${speed}")
+# Seven measures (VBD's two among them), readable and engine room, on 1 and 2 threads:
+# twenty-eight rows.
+if(NOT count EQUAL 29 OR NOT header STREQUAL "grid,springs,measure,ns_per_spring,threads")
+  message(FATAL_ERROR "speed.csv is not a header and twenty-eight rows:\n${speed}")
 endif()
 # A positive figure: a nonzero digit, no sign (an iteration is a difference of two timings, but
 # VBD's eight extra sweeps and the bound's eight extra passes cost far more than the noise).
@@ -88,7 +88,9 @@ foreach(row "16,[0-9]+,xpbd-iteration,[-0-9.e]+,1" "16,[0-9]+,xpbd-iteration-rea
         "16,[0-9]+,vbd-step-1-iteration-readable,${positive},1"
         "16,[0-9]+,vbd-iteration-readable,${positive},1"
         "16,[0-9]+,vbd-step-1-iteration-readable,${positive},2"
-        "16,[0-9]+,vbd-iteration-readable,${positive},2")
+        "16,[0-9]+,vbd-iteration-readable,${positive},2"
+        "16,[0-9]+,vbd-step-1-iteration,${positive},1" "16,[0-9]+,vbd-iteration,${positive},1"
+        "16,[0-9]+,vbd-iteration,${positive},2")
   set(found ${speed})
   list(FILTER found INCLUDE REGEX "^${row}$")
   if(NOT found)
@@ -116,7 +118,8 @@ if(NOT out MATCHES "${two_bound}")
   message(FATAL_ERROR "bench methods --speed printed no bound on two threads:\n${out}")
 endif()
 string(CONCAT vbd "VBD \\(lesson 14\\)[^\n]*\n[^\n]*\n[^\n]*\n +16 x 16 +1 \\| +${positive} "
-       "\\| +${positive} +${positive} \\| +${positive} \\| +${positive}\n")
+       "+${positive} \\| +${positive} +${positive} \\| +${positive} \\| +${positive} \\| "
+       "+[-0-9.]+\n")
 if(NOT out MATCHES "${vbd}")
   message(FATAL_ERROR "bench methods --speed printed no VBD row with positive figures:\n${out}")
 endif()

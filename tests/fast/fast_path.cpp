@@ -24,6 +24,7 @@
 #include "clothlab/forces/bending.hpp"
 #include "clothlab/forces/spring_damper.hpp"
 #include "clothlab/integrators/local_global.hpp"
+#include "clothlab/integrators/vbd.hpp"
 #include "clothlab/integrators/xpbd.hpp"
 #include "fast/aerodynamics.hpp"
 #include "fast/engine.hpp"
@@ -907,23 +908,71 @@ TEST_CASE("fast path: XPBD's projections in the engine room give the readable bi
   }
 }
 
-TEST_CASE("fast path: XPBD with tearing and plasticity recolours and matches the readable path") {
+// A cloth that yields and tears in a storm, stepped by `method` (with `keys` in [integrator]) at
+// 2 ms for 400 steps on the readable path and on 2 threads in the engine room, after `edit`:
+// springs tear, and both paths give the same positions and rest lengths. The engine room's run.
+clothlab::Scene storm_matches_readable(const std::string& method, const std::string& keys,
+                                       const std::function<void(clothlab::World&)>& edit) {
   std::string text =
       cloth("[plasticity]\nyield_strain = 0.02\nmax_strain = 0.4\n[tearing]\nstrain = 0.08\n",
-            "xpbd", 24, 24);
+            method, 24, 24);
   text.replace(text.find("wind = [3, 0, 2]"), 16, "wind = [0, 0, 60]");
-  text.replace(text.find("dt = 0.0005"), 11, "dt = 0.002\nsubsteps = 2");
+  text.replace(text.find("dt = 0.0005"), 11, "dt = 0.002\n" + keys);
   clothlab::Scene readable = run(text, false, 1, 400);
-  clothlab::Scene threaded =
-      run(text, true, 2, 400, [](clothlab::World& w) { engine_of(w).xpbd_split = 1; });
+  clothlab::Scene threaded = run(text, true, 2, 400, edit);
   clothlab::Scene built = clothlab::parse_scene(text, "t");
   REQUIRE(spring_effect(threaded.world, "springs")->springs().size() <
           spring_effect(built.world, "springs")->springs().size());  // springs tore
   CHECK(identical(threaded.world.particles.x, readable.world.particles.x));
   CHECK(spring_effect(threaded.world, "springs")->springs().l0() ==
         spring_effect(readable.world, "springs")->springs().l0());
+  return threaded;
+}
+
+TEST_CASE("fast path: XPBD with tearing and plasticity recolours and matches the readable path") {
+  const clothlab::Scene threaded = storm_matches_readable(
+      "xpbd", "substeps = 2", [](clothlab::World& w) { engine_of(w).xpbd_split = 1; });
   const auto& xpbd = dynamic_cast<const clothlab::Xpbd&>(*threaded.world.integrator);
   CHECK(xpbd.backend_substeps == 400 * 2);
+}
+
+TEST_CASE("fast path: VBD's sweeps in the engine room give the readable bits, 1-4 threads") {
+  // Springs, bending and dampers as the vertex steps' energy; pins, wind, drag, buoyancy and
+  // gravity as external forces; the ground after every step; 3 sweeps at 4 ms, from the adaptive
+  // guess (which reads the last step's velocities).
+  std::string text = cloth("", "vbd", 30, 28);
+  text.replace(text.find("dt = 0.0005"), 11,
+               "dt = 0.004\niterations = 3\ninitial_guess = \"adaptive\"");
+  const int steps = 60;
+  const clothlab::Scene readable = run(text, false, 1, steps);
+  const auto& readable_vbd = dynamic_cast<const clothlab::Vbd&>(*readable.world.integrator);
+  CHECK(readable_vbd.backend_steps == 0);
+  CHECK((readable.world.particles.x - clothlab::parse_scene(text, "t").world.particles.x)
+            .cwiseAbs()
+            .maxCoeff() > 1e-3);  // the cloth moved
+  for (int threads = 1; threads <= 4; ++threads) {
+    for (Index split : {Index{1}, clothlab::Index{1024}}) {
+      CAPTURE(threads);
+      CAPTURE(split);
+      const clothlab::Scene fast = run(text, true, threads, steps,
+                                       [&](clothlab::World& w) { engine_of(w).vbd_split = split; });
+      // The engine room took every step's sweeps: no silent fallback.
+      const auto& vbd = dynamic_cast<const clothlab::Vbd&>(*fast.world.integrator);
+      CHECK(vbd.backend_steps == steps);
+      CHECK(identical(fast.world.particles.x, readable.world.particles.x));
+      CHECK(identical(fast.world.particles.v, readable.world.particles.v));
+    }
+  }
+}
+
+TEST_CASE(
+    "fast path: VBD with tearing and plasticity rebuilds its graph and matches the readable "
+    "path") {
+  const clothlab::Scene threaded = storm_matches_readable(
+      "vbd", "iterations = 4", [](clothlab::World& w) { engine_of(w).vbd_split = 1; });
+  const auto& vbd = dynamic_cast<const clothlab::Vbd&>(*threaded.world.integrator);
+  CHECK(vbd.backend_steps == 400);
+  CHECK(vbd.graph_builds > 1);
 }
 
 // The local/global solver's engine room: the local steps and right-hand sides are the readable

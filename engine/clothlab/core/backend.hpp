@@ -21,6 +21,7 @@ class World;
 struct XpbdConstraints;
 struct LinearSolveStats;
 struct LocalGlobalSystem;
+struct VbdGraph;
 
 // What a backend took of a step (Backend::step).
 struct BackendStep {
@@ -77,6 +78,15 @@ class Backend {
   // derives). False: declined, nothing changed.
   virtual bool local_global_iterate(World& /*world*/, LocalGlobalSystem& /*system*/,
                                     int /*iterations*/) {
+    return false;
+  }
+  // Vertex Block Descent's sweeps of one step of h [s] (integrators/vbd.hpp): `iterations`
+  // times, colour by colour of `graph`, each free vertex one Newton step (vbd_vertex_step) on
+  // world.particles.x, the step having started at x_n, with y where inertia and the external
+  // forces carry each vertex. The same bits as Vbd::advance's own loop. False: declined, nothing
+  // changed.
+  virtual bool vbd_sweeps(World& /*world*/, const VbdGraph& /*graph*/, const Matrix3X& /*x_n*/,
+                          const Matrix3X& /*y*/, double /*h*/, int /*iterations*/) {
     return false;
   }
 };

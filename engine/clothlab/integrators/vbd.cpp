@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <vector>
 
+#include "clothlab/core/backend.hpp"
 #include "clothlab/core/stop.hpp"
 #include "clothlab/core/world.hpp"
 #include "clothlab/forces/gravity.hpp"
@@ -135,8 +136,11 @@ void Vbd::advance(World& world, double dt) {
 
   // The sweeps: colour by colour, each free vertex one Newton step with its neighbours where
   // they are now (Gauss-Seidel). The rest lengths are read each time (plasticity changes them).
+  // The world's backend may take them (the same bits); else this loop does.
   const VbdGraph& g = graph_;
-  for (int it = 0; it < iterations; ++it) {
+  const bool taken = world.backend && world.backend->vbd_sweeps(world, g, x_n_, y_, h, iterations);
+  if (taken) ++backend_steps;
+  for (int it = 0; it < (taken ? 0 : iterations); ++it) {
     stop_point();  // many iterations of a big cloth can take a while (core/stop.hpp)
     for (size_t q = 0; q < static_cast<size_t>(g.colours()); ++q) {
       for (size_t c = g.colour_start[q]; c < g.colour_start[q + 1]; ++c) {

@@ -134,7 +134,8 @@ class Vbd final : public Integrator {
   int force_evaluations_per_step() const override { return 1; }
   std::string_view springs_without_dt_limit() const override { return "implicitly"; }
 
-  int iterations = 10;  // sweeps over every vertex per step ([integrator] iterations)
+  int iterations = 10;     // sweeps over every vertex per step ([integrator] iterations)
+  long backend_steps = 0;  // steps whose sweeps the world's backend took (tests/fast/)
   // [integrator] initial_guess = "inertia" or "adaptive"
   VbdInitialGuess initial_guess = VbdInitialGuess::inertia;
 
