@@ -23,7 +23,6 @@ set(CLOTHLAB_PHYSICS_SOURCES
   clothlab/integrators/implicit_euler.cpp
   clothlab/integrators/xpbd.cpp
   clothlab/integrators/local_global.cpp
-  clothlab/integrators/vbd_vertex.cpp
   clothlab/integrators/vbd.cpp
   clothlab/bodies/cloth.cpp
   clothlab/bodies/rope.cpp

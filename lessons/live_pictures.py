@@ -25,6 +25,7 @@ SHOTS = {
     "11-game-loop": ("banner.toml", 2.0),
     "12-xpbd": ("stiff-curtain.toml", 1.0),
     "13-local-global": ("canvas-curtain.toml", 1.0),
+    "14-vbd": ("stiff-sheet.toml", 1.0),
 }
 
 

@@ -28,6 +28,7 @@ PICTURES = {
     "11-game-loop": ("banner.toml", 240),
     "12-xpbd": ("stiff-curtain.toml", 120),
     "13-local-global": ("canvas-curtain.toml", 120),
+    "14-vbd": ("stiff-sheet.toml", 120),
 }
 
 

@@ -48,6 +48,13 @@ inline double energy(const World& world) {
   return world.kinetic_energy() + world.potential_energy();
 }
 
+// Steps the world by dt for `seconds` of simulated time (the nearest whole number of steps).
+inline void run_for(World& world, double dt, double seconds) {
+  const long steps = std::lround(seconds / dt);
+  for (long s = 0; s < steps; ++s)
+    world.step(dt);
+}
+
 using Clock = std::chrono::steady_clock;
 
 // Wall time since `start` [s].

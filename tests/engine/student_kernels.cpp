@@ -128,3 +128,11 @@ TEST_CASE("student build: method = \"local-global\" projects with the student's 
   clothlab::World& w = scene.world;
   CHECK(stops_at([&] { w.integrator->advance(w, scene.dt); }) == "ex13.1");
 }
+
+TEST_CASE("student build: method = \"vbd\" steps each vertex with the student's kernel (ex14.1)") {
+  // The same spring: the step sums no external force (there is none), builds the colouring (no
+  // kernel), and then calls, first of all kernels, the student's vbd_vertex_step.
+  clothlab::Scene scene = clothlab::parse_scene(one_spring("vbd"), "stubs.toml");
+  clothlab::World& w = scene.world;
+  CHECK(stops_at([&] { w.integrator->advance(w, scene.dt); }) == "ex14.1");
+}

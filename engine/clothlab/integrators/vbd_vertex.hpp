@@ -1,4 +1,5 @@
-// vbd_vertex.hpp: one vertex's Newton step, the kernel of Vertex Block Descent (lesson 14).
+// vbd_vertex.hpp: one vertex's Newton step, the kernel of Vertex Block Descent (lesson 14,
+// exercise ex14.1).
 //
 // Chen, Liu, Yang and Yuksel, "Vertex Block Descent", ACM Transactions on Graphics 43(4)
 // (SIGGRAPH 2024).
@@ -76,6 +77,7 @@ struct VertexBlock {
 // stiff rope (1 g vertices, ks = 1e6 N/m, h = 1/60 s) is at about 1e-10.
 inline constexpr double kSingularBlock = 1e-13;
 
+// Exercise ex14.1, part 1 (solutions/14_vbd.cpp; the student's is in exercises/14_vbd.cpp):
 // G_i's force f [N] and Hessian H [N/m] at vertex i, which is at x_i [m] now and was at
 // x_i_start [m] when the step began, with y_i [m] where inertia and the external forces carry it,
 // inverse mass w_i > 0 [1/kg] (infinite for a massless vertex: no inertia term), the step
@@ -84,7 +86,7 @@ inline constexpr double kSingularBlock = 1e-13;
 VertexBlock vbd_vertex_block(const Vec3& x_i, const Vec3& x_i_start, const Vec3& y_i, double w_i,
                              double h, std::span<const VertexSpring> springs);
 
-// Exercise 14.1 to be: the vertex's Newton step dx = H^-1 f [m] (the arguments as for
+// Exercise ex14.1, part 2: the vertex's Newton step dx = H^-1 f [m] (the arguments as for
 // vbd_vertex_block). A pinned vertex (w_i = 0) never moves: dx = 0. A singular block (the guard
 // above) is skipped: dx = 0, never NaN.
 Vec3 vbd_vertex_step(const Vec3& x_i, const Vec3& x_i_start, const Vec3& y_i, double w_i, double h,

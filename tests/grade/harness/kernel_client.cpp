@@ -404,4 +404,14 @@ Vec3 local_step_projection(const Vec3& x_i, const Vec3& x_j, double l0, const Ve
   return call(CLOTHLAB_KERNEL(local_step_projection), x_i, x_j, l0, d_previous);
 }
 
+VertexBlock vbd_vertex_block(const Vec3& x_i, const Vec3& x_i_start, const Vec3& y_i, double w_i,
+                             double h, std::span<const VertexSpring> springs) {
+  return call(CLOTHLAB_KERNEL(vbd_vertex_block), x_i, x_i_start, y_i, w_i, h, springs);
+}
+
+Vec3 vbd_vertex_step(const Vec3& x_i, const Vec3& x_i_start, const Vec3& y_i, double w_i, double h,
+                     std::span<const VertexSpring> springs) {
+  return call(CLOTHLAB_KERNEL(vbd_vertex_step), x_i, x_i_start, y_i, w_i, h, springs);
+}
+
 }  // namespace clothlab

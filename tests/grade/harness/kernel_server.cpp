@@ -68,7 +68,7 @@ void call_back(const std::function<void(Writer&)>& outs, std::uint32_t kernel, c
 // One kernel: reads its arguments, calls it, sends the result and the changeable arguments.
 template <class R, class... Params>
 void answer(R (*kernel)(Params...), std::uint32_t id, Reader& in) {
-  std::tuple<std::decay_t<Params>...> values;
+  std::tuple<Stored<Params>...> values;
   std::apply([&](auto&... v) { (get(in, v), ...); }, values);
   in.expect_end();
   const std::function<void(Writer&)> outs = [&](Writer& w) { put_outs<Params...>(w, values); };

@@ -46,6 +46,7 @@
 #include <cstdint>
 #include <cstring>
 #include <functional>
+#include <span>
 #include <stdexcept>
 #include <string>
 #include <tuple>
@@ -70,6 +71,7 @@
 #include "clothlab/integrators/local_global.hpp"
 #include "clothlab/integrators/runge_kutta.hpp"
 #include "clothlab/integrators/stability_limit.hpp"
+#include "clothlab/integrators/vbd_vertex.hpp"
 #include "clothlab/integrators/xpbd.hpp"
 
 namespace clothlab::wire {
@@ -99,7 +101,9 @@ namespace clothlab::wire {
   X(pair_response)                    \
   X(accumulate)                       \
   X(xpbd_distance_projection)         \
-  X(local_step_projection)
+  X(local_step_projection)            \
+  X(vbd_vertex_block)                 \
+  X(vbd_vertex_step)
 
 #define CLOTHLAB_KERNEL_ENUM(name) name,
 enum class Kernel : std::uint32_t { CLOTHLAB_EXERCISE_KERNELS(CLOTHLAB_KERNEL_ENUM) count };
@@ -236,6 +240,13 @@ inline void get_shaped(Reader& r, Matrix3X& m, Index cols) {
   r.raw(m.data(), sizeof(double) * 3 * static_cast<std::size_t>(cols));
 }
 
+inline void put(Writer& w, const Mat3& a) {
+  w.raw(a.data(), sizeof(double) * 9);
+}
+inline void get(Reader& r, Mat3& a) {
+  r.raw(a.data(), sizeof(double) * 9);
+}
+
 template <class A, class B>
 void put(Writer& w, const std::pair<A, B>& p) {
   put(w, p.first);
@@ -261,6 +272,15 @@ void get(Reader& r, std::vector<T>& v) {
     get(r, x);
 }
 
+// A span a kernel reads is sent as its elements; the kernels' process holds them in a vector
+// (Stored below), which the kernel then sees as the span.
+template <class T>
+void put(Writer& w, std::span<const T> v) {
+  put(w, std::uint64_t{v.size()});
+  for (const T& x : v)
+    put(w, x);
+}
+
 template <class T, std::size_t N>
 void put(Writer& w, const std::array<T, N>& a) {
   for (const T& x : a)
@@ -274,15 +294,17 @@ void get(Reader& r, std::array<T, N>& a) {
 
 // The structs the kernels take and return, field by field. The static_asserts fail to compile
 // when a field is added to one of them and not here.
-#define CLOTHLAB_WIRE_STRUCT(Type, bytes, ...)                                             \
-  static_assert(sizeof(Type) == (bytes), #Type " changed: list its fields here");          \
-  inline void put(Writer& wire_out, const Type& wire_value) {                              \
-    const auto& [__VA_ARGS__] = wire_value;                                                \
-    std::apply([&](const auto&... f) { (put(wire_out, f), ...); }, std::tie(__VA_ARGS__)); \
-  }                                                                                        \
-  inline void get(Reader& wire_in, Type& wire_value) {                                     \
-    auto& [__VA_ARGS__] = wire_value;                                                      \
-    std::apply([&](auto&... f) { (get(wire_in, f), ...); }, std::tie(__VA_ARGS__));        \
+#define CLOTHLAB_WIRE_STRUCT(Type, bytes, ...)                                       \
+  static_assert(sizeof(Type) == (bytes), #Type " changed: list its fields here");    \
+  inline void put(Writer& wire_out, const Type& wire_value) {                        \
+    const auto& [__VA_ARGS__] = wire_value;                                          \
+    std::apply([&](const auto&... wire_field) { (put(wire_out, wire_field), ...); }, \
+               std::tie(__VA_ARGS__));                                               \
+  }                                                                                  \
+  inline void get(Reader& wire_in, Type& wire_value) {                               \
+    auto& [__VA_ARGS__] = wire_value;                                                \
+    std::apply([&](auto&... wire_field) { (get(wire_in, wire_field), ...); },        \
+               std::tie(__VA_ARGS__));                                               \
   }
 
 CLOTHLAB_WIRE_STRUCT(PointState, 6 * sizeof(double), r, v)
@@ -294,7 +316,24 @@ CLOTHLAB_WIRE_STRUCT(PairState, 12 * sizeof(double), r1, v1, r2, v2)
 CLOTHLAB_WIRE_STRUCT(SelfContact, 4 * sizeof(double), thickness, e, mu_s, mu_d)
 CLOTHLAB_WIRE_STRUCT(Substeps, sizeof(long) + 2 * sizeof(double), count, leftover, dropped)
 CLOTHLAB_WIRE_STRUCT(RungeKuttaStages, 12 * sizeof(Matrix3X), x, v, a)
+CLOTHLAB_WIRE_STRUCT(VertexSpring, 9 * sizeof(double), x_j, x_j_start, ks, kd, l0)
+CLOTHLAB_WIRE_STRUCT(VertexBlock, 12 * sizeof(double), f, H)
 #undef CLOTHLAB_WIRE_STRUCT
+template <>
+inline constexpr std::size_t kMinBytes<VertexSpring> = sizeof(VertexSpring);
+
+// How the kernels' process holds an argument of type Param while the kernel runs: as the value
+// itself, or, for a span (which owns nothing), in a vector of its elements.
+template <class Param>
+struct StoredAs {
+  using type = std::decay_t<Param>;
+};
+template <class T>
+struct StoredAs<std::span<const T>> {
+  using type = std::vector<T>;
+};
+template <class Param>
+using Stored = typename StoredAs<std::decay_t<Param>>::type;
 
 // An AccelerationField is no bytes: it stays in the client's process.
 inline void put(Writer&, const AccelerationField&) {}
