@@ -31,6 +31,7 @@ while IFS= read -r line; do
 done <"$source_dir/tests/grade/harness/planted/mutants.txt"
 solutions=("$source_dir"/solutions/[0-9][0-9]_*.cpp)
 euler="const Vec3 a = f * inv_m;  // Newton: a = f / m"
+# (What is planted goes before the comment, so that it is code.)
 
 rm -rf "$out"
 mkdir -p "$out"
@@ -51,8 +52,8 @@ for ((i = 0; i < n; ++i)); do
       broken=${solutions[$((i / 10 % ${#solutions[@]}))]}
       printf '\nint broken_on_purpose( {\n' >>"$dir/$(basename "$broken")" ;;
     8) plant_line "$dir/01_particles_and_euler.cpp" "$euler" \
-      "$euler while (true) { static volatile int spin; spin = spin + 1; }" ;;
-    9) plant_line "$dir/01_particles_and_euler.cpp" "$euler" "$euler __builtin_trap();" ;;
+      "const Vec3 a = f * inv_m; while (true) { static volatile int spin; spin = spin + 1; }" ;;
+    9) plant_line "$dir/01_particles_and_euler.cpp" "$euler" "const Vec3 a = f * inv_m; __builtin_trap();" ;;
   esac
 done
 echo "make_class: $n submissions in $out"

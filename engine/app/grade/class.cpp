@@ -507,6 +507,14 @@ std::string class_csv(const std::vector<Student>& students, const fs::path& clas
 
 // `text` with the student's name and folder replaced, so an example shows no one.
 std::string anonymised(std::string text, const Student& s) {
+  // The grading tests' files as the project names them (the scratch build sees them through
+  // "../../../tests/...").
+  for (auto at = text.find("../tests/"); at != std::string::npos; at = text.find("../tests/")) {
+    std::size_t from = at;
+    while (from >= 3 && text.compare(from - 3, 3, "../") == 0)
+      from -= 3;
+    text.erase(from, at + 3 - from);
+  }
   for (const std::string& who :
        {s.folder.string(), s.name, s.folder.filename().string(), one_line(s.name)}) {
     if (who.size() < 3) continue;
@@ -585,17 +593,19 @@ std::vector<Wrong> what_went_wrong(const std::vector<Student>& students) {
   return all;
 }
 
-std::string top_hint(const Failing& f) {
-  std::string best;
-  int count = -1;
-  for (const auto& [hint, n] : f.hints) {
-    if (n > count) {
-      best = hint;
-      count = n;
-    }
-  }
-  return best;
+// The hints the students who fail a case got, the most common first, each with how many got it:
+// where a case names the slips it knows, each slip is a line of its own.
+std::vector<std::pair<int, std::string>> ranked_hints(const Failing& f) {
+  std::vector<std::pair<int, std::string>> ranked;
+  for (const auto& [hint, n] : f.hints)
+    ranked.emplace_back(n, hint);
+  std::stable_sort(ranked.begin(), ranked.end(),
+                   [](const auto& a, const auto& b) { return a.first > b.first; });
+  if (ranked.size() > 6) ranked.resize(6);
+  return ranked;
 }
+
+std::string hints_html(const Failing& f);
 
 std::string wrong_text(const std::vector<Wrong>& wrong) {
   std::string s = "What the class got wrong\n========================\n";
@@ -609,7 +619,8 @@ std::string wrong_text(const std::vector<Wrong>& wrong) {
     s += "\n";
     for (const Failing& f : w.failing) {
       s += fmt::format("  {} failed by {}\n", one_line(f.name), f.failed);
-      s += "    hint: " + one_line(top_hint(f)) + "\n";
+      for (const auto& [n, hint] : ranked_hints(f))
+        s += fmt::format("    {} x hint: {}\n", n, one_line(hint));
       s += "    for example:\n" + indent(f.example, "      ") + "\n";
     }
     if (w.failing.empty() && w.not_started + w.not_compiled < w.students)
@@ -713,7 +724,8 @@ bool parse_region(const std::string& line, std::string& a, std::string& b, Regio
 struct Similarity {
   std::string missing;  // why there is no comparison
   std::vector<Compared> compared;
-  std::vector<Pair> pairs;  // ranked
+  std::vector<Pair> pairs;  // ranked, the first 30
+  std::size_t pairs_found = 0;
   double seconds = 0;
 };
 
@@ -797,6 +809,7 @@ Similarity compare(const std::vector<Student>& students, const fs::path& work) {
   std::stable_sort(result.pairs.begin(), result.pairs.end(), [](const Pair& x, const Pair& y) {
     return std::max(x.a_in_b, x.b_in_a) > std::max(y.a_in_b, y.b_in_a);
   });
+  result.pairs_found = result.pairs.size();
   if (result.pairs.size() > 30) result.pairs.resize(30);
   // The matching regions of the pairs shown.
   for (Pair& p : result.pairs) {
@@ -835,13 +848,20 @@ std::string similarity_text(const Similarity& sim, const std::vector<Student>& s
   std::string s = "Similar code (sim_c++, the shipped stubs left out)\n";
   if (!sim.missing.empty()) return s + sim.missing + "\n";
   s += fmt::format("{} submissions compared, {} pairs of 10 % or more (at most 30 shown)\n",
-                   sim.compared.size(), sim.pairs.size());
+                   sim.compared.size(), sim.pairs_found);
   for (const Pair& p : sim.pairs) {
     s += fmt::format("  {:>3} % of {} is in {}; {:>3} % the other way\n", p.a_in_b,
                      one_line(students[sim.compared[p.a].student].name),
                      one_line(students[sim.compared[p.b].student].name), p.b_in_a);
   }
   return s;
+}
+
+std::string hints_html(const Failing& f) {
+  std::string h;
+  for (const auto& [n, hint] : ranked_hints(f))
+    h += fmt::format("{} &times; {}<br>", n, html(one_line(hint)));
+  return h;
 }
 
 std::string page(const std::vector<Student>& students, const std::vector<Wrong>& wrong,
@@ -893,8 +913,8 @@ std::string page(const std::vector<Student>& students, const std::vector<Wrong>&
       h += fmt::format(
           "<tr><td class=\"l\">{}</td><td>{}</td><td class=\"l\">{}<br>{}</td><td "
           "class=\"l\"><pre>{}</pre></td></tr>\n",
-          html(one_line(f.name)), f.failed, html(one_line(top_hint(f))),
-          html(lesson_hint(w.exercise)), html(f.example));
+          html(one_line(f.name)), f.failed, hints_html(f), html(lesson_hint(w.exercise)),
+          html(f.example));
     }
     h += "</table>\n";
   }

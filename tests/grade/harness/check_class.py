@@ -113,8 +113,10 @@ if "Total: 999" in "\n".join(l for l in page.splitlines() if l.startswith("Total
 # What the class got wrong: dave's case, with its hint and his failing output, anonymised.
 wrong = open(os.path.join(out, "what-went-wrong.txt")).read()
 print(wrong)
-if not re.search(r"ex02\.2 \S.* failed by 1\n    hint: .+\n    for example:\n", wrong):
+if not re.search(r"ex02\.2 \S.* failed by 1\n    1 x hint: .+\n    for example:\n", wrong):
     problem("what-went-wrong.txt does not list ex02.2's failing case with a hint and an example")
+if "56 J means the 1/2 is missing" not in wrong or "\n      tests/grade/02_spring_dampers.cpp:" not in wrong:
+    problem("what-went-wrong.txt does not name dave's mistake, or shows the grading file oddly")
 if "dave" in wrong:
     problem("what-went-wrong.txt names a student")
 # Similarity: alice and her copy, at 100 %; the students who handed in the stub are not compared.
