@@ -87,5 +87,23 @@ inline constexpr const char* kStretched =
     "particle 2 (along +e = (r2 - r1) / l) with 28 N; a force pointing away from particle 2 "
     "means the sign of f_sd = -ks (l0 - l) is flipped, or e points from 2 to 1";
 
+// ex09.1, r1 = 0, r2 = (6, 0, 8): l = 10, e = (0.6, 0, 0.8), limit 5, so C = 5. With w1 = 3 and
+// w2 = 1, dr1 = 3/4 C e = (2.25, 0, 3). The shares swapped give 1/4 C e = (0.75, 0, 1); an even
+// split 1/2 C e = (1.5, 0, 2); w1 not divided by w1 + w2, 3 C e = (9, 0, 12).
+inline const std::initializer_list<Slip> kStrainShare = {
+    {Vec3(0.75, 0.0, 1.0),
+     "the shares swapped (particle 1 takes w1 / (w1 + w2): the lighter end moves more)"},
+    {Vec3(1.5, 0.0, 2.0), "the correction split evenly, not by inverse mass"},
+    {Vec3(9.0, 0.0, 12.0), "w1 not divided by w1 + w2"}};
+// ex09.1 with particle 1 pinned, w1 = 0 and w2 = 2: dr1 = 0. The shares swapped give C e =
+// (3, 0, 4); an even split (1.5, 0, 2).
+inline const std::initializer_list<Slip> kStrainPinned = {
+    {Vec3(3.0, 0.0, 4.0),
+     "the shares swapped: the pinned particle moved the whole way (its share is w1 / (w1 + w2) = "
+     "0)"},
+    {Vec3(1.5, 0.0, 2.0),
+     "the correction split evenly: the pinned particle moved half way (its share is w1 / (w1 + "
+     "w2) = 0)"}};
+
 }  // namespace slips
 }  // namespace grading
