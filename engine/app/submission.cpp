@@ -71,55 +71,10 @@ void take_file(const fs::path& from, const fs::path& to, const fs::path& stub) {
   write_new_file(to, text);
 }
 
-// One exercise file of the project and the shipped stub of it, as the kit lists them.
-struct ExerciseFile {
-  std::string name;  // "01_particles_and_euler.cpp"
-  fs::path stub;
-};
-
-std::vector<ExerciseFile> kit_exercises(const fs::path& kit) {
-  std::ifstream in(kit / "exercises.txt");
-  if (!in) throw std::runtime_error((kit / "exercises.txt").string() + " cannot be read");
-  std::vector<ExerciseFile> files;
-  std::string line;
-  while (std::getline(in, line)) {
-    const auto tab = line.find('\t');
-    if (tab == std::string::npos) continue;
-    files.push_back({line.substr(0, tab), fs::path(line.substr(tab + 1))});
-  }
-  return files;
-}
-
 constexpr std::uintmax_t kMaxFileBytes = 1 << 20;  // an exercise file is a few kilobytes
 // Any file a submission's build writes: an object of an exercise file is well under a megabyte,
 // the kernels program a few (a 1 GB object, a large array's zeros spelt out, is refused).
 constexpr std::size_t kMaxBuildFileBytes = std::size_t{64} << 20;
-
-// Where a submission keeps `name`: at its top, or in an exercises/ folder (a copy of the
-// starter repository). Empty when it has neither, or when what it has there is refused: only a
-// regular file inside the submission folder is taken, never a symbolic link (to solutions/, say),
-// a device (/dev/zero), a folder or a file of more than kMaxFileBytes. `why` then says which.
-fs::path find_in_submission(const fs::path& dir, const std::string& name, std::string& why) {
-  std::error_code ec;
-  const fs::path root = fs::weakly_canonical(dir, ec);
-  for (const fs::path& candidate : {dir / name, dir / "exercises" / name}) {
-    const fs::file_status status = fs::symlink_status(candidate, ec);
-    if (ec || !fs::exists(status)) continue;
-    if (fs::is_symlink(status)) {
-      why = name + " (a symbolic link)";
-    } else if (!fs::is_regular_file(status)) {
-      why = name + " (not a regular file)";
-    } else if (!fs::weakly_canonical(candidate, ec).string().starts_with(root.string() + "/")) {
-      why = name + " (in a folder that links outside the submission)";
-    } else if (fs::file_size(candidate, ec) > kMaxFileBytes) {
-      why = name + " (larger than 1 MiB)";
-    } else {
-      return candidate;
-    }
-    return {};
-  }
-  return {};
-}
 
 std::string replace_all(std::string text, const std::string& from, const std::string& to) {
   if (from.empty()) return text;
@@ -236,6 +191,42 @@ std::string first_build_error(const std::string& log, int max_lines, const std::
   return "";
 }
 
+std::vector<KitExercise> kit_exercise_files() {
+  const fs::path kit = grade_kit_dir();
+  std::ifstream in(kit / "exercises.txt");
+  if (!in) throw std::runtime_error((kit / "exercises.txt").string() + " cannot be read");
+  std::vector<KitExercise> files;
+  std::string line;
+  while (std::getline(in, line)) {
+    const auto tab = line.find('\t');
+    if (tab == std::string::npos) continue;
+    files.push_back({line.substr(0, tab), fs::path(line.substr(tab + 1))});
+  }
+  return files;
+}
+
+fs::path find_exercise_file(const fs::path& dir, const std::string& name, std::string& why) {
+  std::error_code ec;
+  const fs::path root = fs::weakly_canonical(dir, ec);
+  for (const fs::path& candidate : {dir / name, dir / "exercises" / name}) {
+    const fs::file_status status = fs::symlink_status(candidate, ec);
+    if (ec || !fs::exists(status)) continue;
+    if (fs::is_symlink(status)) {
+      why = name + " (a symbolic link)";
+    } else if (!fs::is_regular_file(status)) {
+      why = name + " (not a regular file)";
+    } else if (!fs::weakly_canonical(candidate, ec).string().starts_with(root.string() + "/")) {
+      why = name + " (in a folder that links outside the submission)";
+    } else if (fs::file_size(candidate, ec) > kMaxFileBytes) {
+      why = name + " (larger than 1 MiB)";
+    } else {
+      return candidate;
+    }
+    return {};
+  }
+  return {};
+}
+
 std::vector<std::string> kit_inputs() {
   const fs::path kit = grade_kit_dir();
   std::vector<std::string> inputs{kit.string()};
@@ -322,10 +313,10 @@ SubmissionBuild build_submission(const std::string& submission_dir, const std::s
   if (fresh) chmod(exercises.c_str(), 0755);
 
   // The submission's files over the stubs, file by file.
-  const std::vector<ExerciseFile> files = kit_exercises(kit);
-  for (const ExerciseFile& file : files) {
+  const std::vector<KitExercise> files = kit_exercise_files();
+  for (const KitExercise& file : files) {
     std::string why;
-    const fs::path found = find_in_submission(from, file.name, why);
+    const fs::path found = find_exercise_file(from, file.name, why);
     if (!why.empty()) result.refused.push_back(why);
     if (found.empty()) {
       if (why.empty()) result.missing.push_back(file.name);
@@ -346,7 +337,7 @@ SubmissionBuild build_submission(const std::string& submission_dir, const std::s
     for (const auto& entry : fs::directory_iterator(dir, ec)) {
       const std::string name = entry.path().filename().string();
       const bool known = std::any_of(files.begin(), files.end(),
-                                     [&](const ExerciseFile& f) { return f.name == name; });
+                                     [&](const KitExercise& f) { return f.name == name; });
       if (entry.path().extension() == ".cpp" && !known) result.ignored.push_back(name);
     }
   }
@@ -410,7 +401,7 @@ SubmissionBuild build_submission(const std::string& submission_dir, const std::s
   };
   while (failed() && !compile.interrupted && !compile.timed_out) {
     bool blamed = false;
-    for (const ExerciseFile& file : files) {
+    for (const KitExercise& file : files) {
       if (std::any_of(result.broken.begin(), result.broken.end(),
                       [&](const SubmissionBuild::Broken& b) { return b.name == file.name; }))
         continue;

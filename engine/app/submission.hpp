@@ -9,6 +9,7 @@
 // Nothing of the submission runs here: it is only compiled, and no test is linked with it.
 #pragma once
 
+#include <filesystem>
 #include <memory>
 #include <string>
 #include <vector>
@@ -56,6 +57,24 @@ struct SubmissionBuild {
 // earlier build, so nothing compiled from another submission is there to read.
 SubmissionBuild build_submission(const std::string& submission_dir, const std::string& scratch_dir,
                                  double timeout, const Confinement* confinement = nullptr);
+
+// One exercise file of the project and its shipped stub, as the build kit lists them.
+struct KitExercise {
+  std::string name;  // "01_particles_and_euler.cpp"
+  std::filesystem::path stub;
+};
+
+// The exercise files the kit knows (grade-kit/exercises.txt); throws std::runtime_error when the
+// kit is missing.
+std::vector<KitExercise> kit_exercise_files();
+
+// Where a submission in `dir` keeps the exercise file `name`: at its top, or in its exercises/
+// folder (a copy of the starter repository). Empty when it has neither, or when what it has there
+// is refused: only a regular file inside the submission folder is taken, never a symbolic link (to
+// solutions/, say), a device (/dev/zero), a folder or a file of more than 1 MiB. `why` then says
+// which.
+std::filesystem::path find_exercise_file(const std::filesystem::path& dir, const std::string& name,
+                                         std::string& why);
 
 // What a submission's build reads besides the system and its own files: the kit, the engine's
 // headers, and the objects of the project's build it links (grade-kit/inputs.txt).

@@ -22,6 +22,7 @@
 #include <string>
 
 #include "clothlab/core/types.hpp"
+#include "slips.hpp"
 
 #define POINTS(n) doctest::description("points=" #n)
 #define POINTS_VISIBILITY(n, visibility) \

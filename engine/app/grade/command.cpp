@@ -4,6 +4,7 @@
 #include "app/exit_codes.hpp"
 #include "app/grade.hpp"
 #include "app/grade/cases.hpp"
+#include "app/grade/class.hpp"
 #include "app/grade/exercises.hpp"
 #include "app/grade/reports.hpp"
 #include "app/grade/text.hpp"
@@ -62,6 +63,11 @@ struct Options {
   std::string exercises;         // hidden: the student's exercise files; default exercises/
   int rounds = 0;                // watch: stop after this many gradings (0: never; for tests)
   std::string web_build;         // watch, hidden: rebuild the student pages of this web build
+  std::string class_dir;         // grade every submission folder in it (class.hpp)
+  std::string out;               // --class: where the reports go
+  int jobs = 0;                  // --class: submissions graded at a time (0: one per core)
+  std::string record;            // hidden: write the submission's record here (for --class)
+  bool kit_ready = false;        // hidden: the kit is built (by --class), do not build it again
 };
 
 // A program of the build folder: the grading binary and the kernels programs are built next to
@@ -185,6 +191,16 @@ void write_reports(const Options& o, const std::vector<Case>& cases, double seco
 }
 
 void grade(const Options& o) {
+  if (!o.class_dir.empty()) {
+    if (!o.submission.empty() || o.impl != "student" || o.list || !o.classroom.empty() ||
+        !o.results.empty() || !o.junit.empty())
+      fail(kExitBadInput,
+           "--class grades every submission in its folder and writes its own reports: it takes "
+           "none of --submission, --impl, --list, --classroom, --results or --junit");
+    grade_class({o.class_dir, o.out, o.jobs, o.timeout, o.build_timeout, o.sandbox,
+                 o.kernels_as_root, o.hidden, o.exercise});
+    return;
+  }
   const bool submission = !o.submission.empty();
   // The student's own exercises, built before they are graded, so that a grade is never that
   // of a binary older than the files.
@@ -194,7 +210,7 @@ void grade(const Options& o) {
   check_report_path("--junit", o.junit);
   check_report_path("--classroom", o.classroom);
   adopt_orphans();  // a process a case leaves behind is handed to the grader, which ends it
-  if ((submission || own) &&
+  if ((submission || own) && !o.kit_ready &&
       (grading || !fs::exists(fs::path(grade_kit_dir()).parent_path() / "grade-cases"))) {
     const std::string why = update_grade_kit(o.build_timeout);
     if (!why.empty()) fail(kExitBadInput, why);
@@ -237,6 +253,7 @@ void grade(const Options& o) {
   std::string notes;
   bool compiled = true;
   std::shared_ptr<void> hold;  // the scratch folder's lock, while its binary is graded
+  double build_seconds = 0;    // building the kernels
   // A submission is compiled, and its kernels run, as nobody (when the grader is root) and in the
   // sandbox where it works (sandbox.hpp); where it does not, the grader says loudly what the
   // submission can then do.
@@ -288,8 +305,10 @@ void grade(const Options& o) {
     const std::string scratch = !o.scratch.empty() ? o.scratch
                                 : submission       ? default_scratch()
                                                    : own_scratch();
+    const auto build_start = Clock::now();
     grader.kernels = build_kernels(dir, scratch, submission, o, submission ? &confinement : nullptr,
                                    cases, notes, colour, hold);
+    build_seconds = std::chrono::duration<double>(Clock::now() - build_start).count();
     compiled = !grader.kernels.empty();
     fmt::print("{}", notes);
   }
@@ -321,6 +340,8 @@ void grade(const Options& o) {
   if (g_interrupted)
     fail(kExitInterrupted, "interrupted: the results of the cases run so far are written");
   if (o.autolab) fmt::print("{}\n", autolab_line(cases));
+  if (!o.record.empty())
+    write_file(o.record, submission_record(cases, notes, build_seconds, elapsed()));
 
   if (o.require_full) {
     const auto failed =
@@ -543,6 +564,22 @@ void add_grade_command(CLI::App& app) {
                 "End with Autolab's one-line JSON summary of the scores per exercise");
   cmd->add_option("--classroom", o->classroom,
                   "Write a GitHub Classroom workflow (one step per exercise) here; grade nothing");
+  CLI::Option* class_dir =
+      cmd->add_option("--class", o->class_dir,
+                      "Grade every submission folder in this folder (a folder per student, or "
+                      "Gradescope's export), a few at a time, into --out")
+          ->excludes(binary);
+  cmd->add_option("--out", o->out,
+                  "With --class: where the reports go (default: the class folder's name with "
+                  "-report)")
+      ->needs(class_dir);
+  cmd->add_option("--jobs", o->jobs,
+                  "With --class: submissions graded at a time (default: one "
+                  "per core)")
+      ->check(CLI::Range(1, 256))
+      ->needs(class_dir);
+  cmd->add_option("--record", o->record, "Write the submission's record here")->group("");
+  cmd->add_flag("--kit-ready", o->kit_ready, "The kit is built: do not build it")->group("");
   cmd->callback([o] { grade(*o); });
 }
 

@@ -24,6 +24,7 @@
 # nothing).
 set -euo pipefail
 source "$(dirname "$0")/submission_checks.sh"
+source "$(dirname "$0")/plant.sh"
 plants=$4
 
 # The results' total score, their maximum, and the cases that scored, from results.json (read
@@ -69,22 +70,6 @@ grade() {
   summary=$(cmake -DRESULTS="$work/$name.json" -P "$work/read_results.cmake" 2>&1)
   read -r score max <<<"${summary%%$'\n'*}"
   [[ $summary == *$'\n'* ]] && scored=${summary#*$'\n'} || scored=""
-}
-
-# plant_line FILE OLD NEW: replaces the one line of FILE that reads OLD (leading spaces aside)
-# with NEW, indented as it was.
-plant_line() {
-  local file=$1 old=$2 new=$3 count
-  count=$(awk -v old="$old" '{ s = $0; sub(/^[ \t]+/, "", s); if (s == old) n++ } END { print n + 0 }' "$file")
-  if [[ $count -ne 1 ]]; then
-    problem "$(basename "$file"): the line \"$old\" occurs $count times (expected once)"
-    return 1
-  fi
-  awk -v old="$old" -v new="$new" '{
-    s = $0; sub(/^[ \t]+/, "", s)
-    if (s == old) { match($0, /^[ \t]*/); print substr($0, 1, RLENGTH) new } else print
-  }' "$file" >"$file.new"
-  mv "$file.new" "$file"
 }
 
 # plant_regions FILE BODIES: replaces the regions of FILE in order with the bodies listed in the
