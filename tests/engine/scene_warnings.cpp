@@ -3,10 +3,12 @@
 // in Scene::warnings, and still loads. A scene without such a mistake gets none.
 #include <doctest/doctest.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <random>
 #include <string>
+#include <vector>
 
 #include "scene/scene.hpp"
 #include "scene/scene_warnings.hpp"
@@ -53,9 +55,9 @@ TEST_CASE("scene warning: none for a scene without mistakes") {
   CHECK(scene.world.particles.size() == clothlab::kAllPairsWarnAbove);
   CHECK(scene.warnings.empty());
 
-  // Nor does any scene a lesson ships, unless it says which warning it means to raise (a scene
-  // that shows a mistake's effect), in a comment line "# warns on purpose: TEXT": then it raises
-  // exactly one warning, and that warning contains TEXT.
+  // Nor does any scene a lesson ships, unless it says which warnings it means to raise (a scene
+  // that shows a mistake's effect), each in a comment line "# warns on purpose: TEXT": then it
+  // raises exactly that many warnings, and each TEXT is in one of them.
   const fs::path lessons = fs::path(CLOTHLAB_TEST_SCENES) / ".." / ".." / "lessons";
   int scenes = 0, on_purpose = 0;
   for (const auto& entry : fs::recursive_directory_iterator(lessons)) {
@@ -63,22 +65,29 @@ TEST_CASE("scene warning: none for a scene without mistakes") {
     ++scenes;
     const clothlab::Scene lesson = clothlab::load_scene_file(entry.path());
     std::ifstream file(entry.path());
-    std::string line, meant;
+    std::string line;
+    std::vector<std::string> meant;
     const std::string marker = "# warns on purpose: ";
     while (std::getline(file, line))
-      if (line.rfind(marker, 0) == 0) meant = line.substr(marker.size());
+      if (line.rfind(marker, 0) == 0) meant.push_back(line.substr(marker.size()));
     if (meant.empty()) {
       for (const clothlab::SceneWarning& w : lesson.warnings)
         FAIL_CHECK("a lesson scene warns: " << w.text());
       continue;
     }
     ++on_purpose;
-    INFO(entry.path().string() << " says it warns on purpose: " << meant);
-    REQUIRE(lesson.warnings.size() == 1);
-    CHECK(lesson.warnings[0].text().find(meant) != std::string::npos);
+    INFO(entry.path().string() << " says it warns on purpose " << meant.size() << " times");
+    REQUIRE(lesson.warnings.size() == meant.size());
+    for (const std::string& one : meant) {
+      INFO("the warning meant: " << one);
+      CHECK(std::any_of(lesson.warnings.begin(), lesson.warnings.end(),
+                        [&](const clothlab::SceneWarning& w) {
+                          return w.text().find(one) != std::string::npos;
+                        }));
+    }
   }
   CHECK(scenes > 10);
-  CHECK(on_purpose < 3);  // a handful at most: a lesson's scenes are meant to be clean
+  CHECK(on_purpose <= 5);  // a handful at most: a lesson's scenes are meant to be clean
 }
 
 TEST_CASE("scene warning: a particle pinned twice") {
