@@ -10,7 +10,9 @@
 //      method; `lesson08 --dense` adds a dense eigen-solver), and the largest dt at which
 //      symplectic Euler keeps the sheet's springs bounded, by bisection;
 //   6. stiff-sheet.toml with symplectic Euler (the guard stops it) and implicit Euler at the
-//      same 10 ms, and symplectic Euler at the step it can take: cost and motion.
+//      same 10 ms, and symplectic Euler at the step it can take: cost and motion;
+//   7. your ex08.1 on the springs the advisor never asks about (a mass other than 1 kg, no
+//      spring, no damper either): the step's spectral radius just below and above its answer.
 // ./build/lesson08 runs on the reference solutions, ./build/lesson08-student on your exercises
 // (it needs those of lessons 01 to 04 and 07); while one is still a stub, the program names it
 // and exits with code 4.
@@ -37,6 +39,7 @@
 #include "clothlab/forces/spring_damper.hpp"
 #include "clothlab/integrators/implicit_euler.hpp"
 #include "clothlab/integrators/methods.hpp"
+#include "clothlab/integrators/stability_limit.hpp"
 #include "scene/scene.hpp"
 
 using namespace clothlab;
@@ -542,6 +545,51 @@ void stiff_sheet() {
 
 }  // namespace
 
+// --- 7. Your limit on any spring -----------------------------------------------------------------
+
+// The advisor asks ex08.1 about m = 1 kg springs only (w^2 and beta = c / m), so a kernel that
+// mishandles the mass or a missing spring passes every scene. Here it is asked directly, and its
+// answer checked the way the grader checks it: one explicit Euler step's spectral radius is at
+// most 1 at 0.999 of the answer and above 1 at 1.001 of it (an answer of "any dt": at most 1 at
+// 1000 s). The matrix is the engine's, from w = sqrt(k / m) and beta = c / m.
+void your_limit() {
+  fmt::print(
+      "7. Your ex08.1 on springs the advisor never asks about: rho - 1, rho the spectral radius\n"
+      "   of one explicit Euler step, at 0.999 and 1.001 of your limit (<= 0 below, > 0 above)\n");
+  fmt::print("   {:<37} {:>11}  {:>10}  {:>10}  {}\n", "spring", "your dt [s]", "at 0.999",
+             "at 1.001", "verdict");
+  struct Spring {
+    const char* name;
+    double k, m, c;
+  };
+  const Spring springs[] = {{"a cloth's spring, 0.34 g", 2e4, 3.4e-4, 0.02},
+                            {"a 0.3 kg bob, lightly damped", 100.0, 0.3, 0.5},
+                            {"a dashpot, k = 1, c = 10", 1.0, 1.0, 10.0},
+                            {"a damper alone, m = 2 kg, c = 4", 0.0, 2.0, 4.0},
+                            {"a free particle, no spring, no damper", 0.0, 1.0, 0.0}};
+  for (const Spring& s : springs) {
+    const double dt = largest_stable_dt_explicit_euler(s.k, s.m, s.c);
+    const auto rho = [&](double h) {
+      return spectral_radius(
+          oscillator_step_matrix("explicit-euler", h, std::sqrt(s.k / s.m), s.c / s.m));
+    };
+    if (std::isinf(dt) && dt > 0.0) {
+      const double far = rho(1000.0);
+      fmt::print("   {:<37} {:>11}  {:>10.2e}  {:>10}  {}\n", s.name, "any", far - 1.0, "-",
+                 far <= 1.0 + 1e-12 ? "ok" : "WRONG: unstable at 1000 s");
+      continue;
+    }
+    const double below = rho(0.999 * dt), above = rho(1.001 * dt);
+    const bool ok = std::isfinite(dt) && dt > 0.0 && below <= 1.0 + 1e-12 && above > 1.0;
+    fmt::print("   {:<37} {:>11.4g}  {:>10.2e}  {:>10.2e}  {}\n", s.name, dt, below - 1.0,
+               above - 1.0,
+               ok                        ? "ok"
+               : std::isnan(dt)          ? "WRONG: not a number"
+               : !(below <= 1.0 + 1e-12) ? "WRONG: unstable below it"
+                                         : "WRONG: still stable above it");
+  }
+}
+
 int main(int argc, char** argv) {
   return lesson::run("lesson08", [&] {
     limits_table();
@@ -550,5 +598,7 @@ int main(int argc, char** argv) {
     conservation();
     stiffest_mode(argc > 1 && std::string_view(argv[1]) == "--dense");
     stiff_sheet();
+    fmt::print("\n");
+    your_limit();
   });
 }

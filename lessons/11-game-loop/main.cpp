@@ -7,7 +7,9 @@
 //   3. a game session at 60 frames per second: a corner dragged with move_pin, a gust of wind
 //      ramped in with set_wind, the banner's state every half second;
 //   4. the same gust switched on at once: how much harder the force jumps;
-//   5. the spiral of death on a machine too slow for its step, with and without the cap.
+//   5. the spiral of death on a machine too slow for its step, with and without the cap;
+//   6. a frame that ends on a whole step, and a frame after an hour's pause: the leftover to
+//      its last digits, where a negative one or a counting loop's drift would show.
 // `lesson11 --view FILE.html` also writes the viewer page of the session in 3.
 // ./build/lesson11 runs on the reference solutions, ./build/lesson11-student on your exercises;
 // while an exercise is still a stub, the program names it and exits with code 4.
@@ -200,6 +202,27 @@ void spiral_of_death() {
   }
 }
 
+// Three frames of 1/60 s (the third ends on a whole step: 50 ms), then a frame of an hour, the
+// game's window left in the background, and one more. The leftover is printed in steps to three
+// significant digits, so that a rounding error shows with its sign: the reference's is 0 or a
+// fraction of a step, never below 0. The hour holds 3.6 million steps; all but the cap's are
+// dropped, and a frame that counts them by subtracting dt one step at a time collects a
+// rounding error from each subtraction.
+void long_pause() {
+  Simulation sim(kBanner);
+  fmt::print(
+      "6. Three frames of 1/60 s, a pause of an hour, one more frame (at most {} substeps a "
+      "frame)\n",
+      sim.max_substeps());
+  fmt::print("   {:>12}  {:>9}  {:>15}  {:>10}  {:>12}\n", "frame [s]", "substeps", "leftover [dt]",
+             "alpha", "dropped [s]");
+  for (double frame : {1.0 / 60, 1.0 / 60, 1.0 / 60, 3600.0, 1.0 / 60}) {
+    const long n = sim.advance(frame);
+    fmt::print("   {:>12.6f}  {:>9}  {:>15.3g}  {:>10.3g}  {:>12.3f}\n", frame, n,
+               sim.leftover() / sim.dt(), sim.alpha(), sim.dropped_time());
+  }
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -223,6 +246,8 @@ int main(int argc, char** argv) {
                ramped.largest_jerk, instant.largest_jerk,
                instant.largest_jerk / ramped.largest_jerk);
     spiral_of_death();
+    fmt::print("\n");
+    long_pause();
     return 0;
   });
 }
