@@ -149,7 +149,7 @@ TEST_CASE("float: the float spring kernel is the lecture's spring-damper") {
             .isZero());
 }
 
-TEST_CASE("float: a scene asks for float in [engine]; anything else is an error at its place") {
+TEST_CASE("float: a bad precision or a scene float does not cover is an error at the key") {
   // A value that is not a precision: file, line and column of the value, what was expected.
   const std::string half = load_error(cloth("symplectic-euler", 0.0005, "", "half"));
   CHECK(half.find("float.toml:") == 0);
