@@ -55,22 +55,26 @@ std::string uncovered(const Effects& effects, Covered covered) {
   return names;
 }
 
+// The methods and the post-step effects the float room covers.
+bool covered(const Integrator* integrator) {
+  return !integrator || dynamic_cast<const SymplecticEuler*>(integrator) ||
+         dynamic_cast<const ExplicitEuler*>(integrator);
+}
+bool covered(const PostStepEffect& effect) {
+  return dynamic_cast<const Ground*>(&effect) || dynamic_cast<const Plane*>(&effect) ||
+         dynamic_cast<const Sphere*>(&effect) || dynamic_cast<const MovingPins*>(&effect);
+}
+
 }  // namespace
 
 std::string float_room_declines(const World& world) {
   std::string why;
-  const Integrator* integrator = world.integrator.get();
-  if (integrator && !dynamic_cast<const SymplecticEuler*>(integrator) &&
-      !dynamic_cast<const ExplicitEuler*>(integrator)) {
-    why = "the method " + std::string(integrator->name());
-  }
+  if (!covered(world.integrator.get())) why = "the method " + std::string(world.integrator->name());
   std::string effects = uncovered(world.force_effects, [](const ForceEffect& effect) {
     return fast_force_float(effect) != nullptr;
   });
-  const std::string after = uncovered(world.post_step_effects, [](const PostStepEffect& effect) {
-    return dynamic_cast<const Ground*>(&effect) || dynamic_cast<const Plane*>(&effect) ||
-           dynamic_cast<const Sphere*>(&effect) || dynamic_cast<const MovingPins*>(&effect);
-  });
+  const std::string after = uncovered(world.post_step_effects,
+                                      [](const PostStepEffect& effect) { return covered(effect); });
   if (!after.empty()) effects += (effects.empty() ? "" : ", ") + after;
   if (!effects.empty()) {
     why += (why.empty() ? "" : " and ") +
@@ -93,19 +97,24 @@ std::string use_float(World& world) {
 }
 
 BackendStep FloatRoom::step(World& world, double dt) {
-  if (const std::string why = float_room_declines(world); !why.empty()) {
-    throw std::logic_error("precision = \"float\" covers " + std::string(kFloatCovers) +
-                           "; this world has " + why);
-  }
-  // Each force effect's float form, made again only for an effect not seen at this place.
+  // Each force effect's float form, made again only for an effect not seen at this place. A
+  // world that holds something not covered (added since the scene loaded) stops here.
   const auto& effects = world.force_effects;
   forces_.resize(effects.size());
-  Particles& p = world.particles;
+  bool all_covered = covered(world.integrator.get());
   for (size_t e = 0; e < effects.size(); ++e) {
-    FastForceSlot<float>& force = forces_[e];
-    force.match(*effects[e], fast_force_float);
-    force.fast->prepare(p);  // float spring forms take every set (springs.cpp)
+    forces_[e].match(*effects[e], fast_force_float);
+    all_covered = all_covered && forces_[e].fast;
   }
+  for (const auto& effect : world.post_step_effects)
+    all_covered = all_covered && covered(*effect);
+  if (!all_covered) {
+    throw std::logic_error("precision = \"float\" covers " + std::string(kFloatCovers) +
+                           "; this world has " + float_room_declines(world));
+  }
+  Particles& p = world.particles;
+  for (const FastForceSlot<float>& force : forces_)
+    force.fast->prepare(p);  // float spring forms take every set (springs.cpp)
   const bool symplectic = dynamic_cast<const SymplecticEuler*>(world.integrator.get()) != nullptr;
   const Index n = p.size();
   CopiesOf<float>& c = copies_;
