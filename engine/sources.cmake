@@ -53,7 +53,8 @@ set(CLOTHLAB_FAST_SOURCES
   fast/aerodynamics.cpp
   fast/xpbd.cpp
   fast/implicit.cpp
-  fast/vbd.cpp)
+  fast/vbd.cpp
+  fast/float_room.cpp)
 # The engine room's parts that need CHOLMOD (libsuitesparse-dev): the native build only. The web
 # module (engine/web/) leaves them out and runs the lecture's local/global loop, on Eigen's solver.
 set(CLOTHLAB_FAST_CHOLMOD_SOURCES

@@ -7,6 +7,9 @@
 // with like:
 //
 //   reference       the engine's own step (the fast path), on 1 thread and on every core
+//   float           the same step in single precision ([engine] precision = "float", the float
+//                   room), 1 thread and every core, with its time over reference's of the same
+//                   run and its distance from reference after 20 steps
 //   readable        the same step on the readable path ([engine] fast_path = false)
 //   naive           a lecture-style engine kept here: an array of particle objects, spring
 //                   objects holding pointers to their two particles, ComputeForce() per spring
@@ -22,9 +25,9 @@
 //   implicit        implicit Euler on a stiff cloth: the whole step, then its assembly (forces,
 //                   Jacobians, the matrix) and its linear solve
 //
-// All variants but `kernel` and `implicit` compute the same physics; the naive and bare ones are
-// checked against the engine after a few steps, and the readable and fast paths agree bit for
-// bit (a test checks it).
+// All variants but `kernel` and `implicit` compute the same physics; the naive, bare and float
+// ones are checked against the engine after a few steps, and the readable and fast paths agree
+// bit for bit (a test checks it).
 #include <unistd.h>
 
 #include <algorithm>
@@ -79,6 +82,7 @@ struct SpeedOptions {
   std::vector<std::string> variants;  // empty: every variant
   bool quick = false;
   bool no_student = false;
+  bool single = false;  // --float: the float rows and the double rows they are compared with
 };
 
 struct Measurement {
@@ -102,7 +106,7 @@ constexpr double kDt = 5e-4;  // [s]
 
 std::string cloth_scene(int n, int threads, bool fast, const std::string& extra,
                         const std::string& method = "symplectic-euler", double ks = kKs,
-                        double dt = kDt, bool bending = true) {
+                        double dt = kDt, bool bending = true, bool single = false) {
   return fmt::format(
       "title = \"bench speed\"\n"
       "[cloth]\nrows = {0}\ncols = {0}\nspacing = {1}\norigin = [0.0, 1.0, 0.0]\nmass = {2}\n"
@@ -111,10 +115,10 @@ std::string cloth_scene(int n, int threads, bool fast, const std::string& extra,
       "{5}"
       "[gravity]\n{6}\n"
       "[integrator]\nmethod = \"{7}\"\ndt = {8}\nduration = 1000.0\n"
-      "[engine]\nthreads = {9}\nfast_path = {10}\n",
+      "[engine]\nthreads = {9}\nfast_path = {10}\nprecision = \"{11}\"\n",
       n, kSpacing, kParticleMass * n * n, ks, kKd,
       bending ? fmt::format("[bending]\nks = {}\nkd = {}\n", kBendKs, kBendKd) : "", extra, method,
-      dt, threads, fast ? "true" : "false");
+      dt, threads, fast ? "true" : "false", single ? "float" : "double");
 }
 
 long spring_count(const World& world) {
@@ -406,6 +410,35 @@ void measure_size(int n, int all_cores, const SpeedOptions& opt, std::vector<Mea
     for (int threads : thread_counts)
       engine("reference", threads, true, "");
   }
+  if (wanted(opt, "float")) {
+    for (int threads : thread_counts) {
+      scenes.push_back(std::make_unique<Scene>(parse_scene(
+          cloth_scene(n, threads, true, "", "symplectic-euler", kKs, kDt, true, /*single=*/true),
+          "<bench>")));
+      Scene& scene = *scenes.back();
+      // How far single precision takes the cloth from the double run in 20 steps, against the
+      // distance the cloth moved: rounding's drift, not another physics.
+      Scene check = parse_scene(
+          cloth_scene(n, 1, true, "", "symplectic-euler", kKs, kDt, true, /*single=*/true),
+          "<bench>");
+      Scene reference = parse_scene(cloth_scene(n, 1, true, ""), "<bench>");
+      const Matrix3X start = reference.world.particles.x;
+      for (int k = 0; k < 20; ++k) {
+        check.world.step(check.dt);
+        reference.world.step(reference.dt);
+      }
+      const double gap =
+          (check.world.particles.x - reference.world.particles.x).cwiseAbs().maxCoeff();
+      const double moved = (reference.world.particles.x - start).cwiseAbs().maxCoeff();
+      contenders.push_back({"float",
+                            threads,
+                            spring_count(scene.world),
+                            [&scene] { scene.world.step(scene.dt); },
+                            {}});
+      notes.push_back(
+          fmt::format("{:.1e} m from reference after 20 steps (moved {:.1e} m)", gap, moved));
+    }
+  }
   if (wanted(opt, "readable")) engine("readable", 1, false, "");
   NaiveCloth naive;
   if (wanted(opt, "naive")) {
@@ -502,9 +535,21 @@ void measure_size(int n, int all_cores, const SpeedOptions& opt, std::vector<Mea
   }
 
   time_steps(contenders, opt);
+  const size_t first_row = rows.size();
   for (size_t k = 0; k < contenders.size(); ++k) {
     const Contender& c = contenders[k];
     rows.push_back(make_row(c.variant, n, c.threads, c.springs, median(c.samples), notes[k]));
+  }
+  // The float step over the double step on as many threads, both measured in this run.
+  for (size_t k = first_row; k < rows.size(); ++k) {
+    if (rows[k].variant != "float") continue;
+    for (size_t r = first_row; r < rows.size(); ++r) {
+      if (rows[r].variant == "reference" && rows[r].threads == rows[k].threads) {
+        rows[k].note =
+            fmt::format("float / reference {:.2f}; {}",
+                        rows[k].ns_per_spring_step / rows[r].ns_per_spring_step, rows[k].note);
+      }
+    }
   }
   if (implicit) {
     // Its assembly and its solve, as averages over every step it took (the figure above is
@@ -605,6 +650,9 @@ void print_table(const std::vector<Measurement>& rows) {
 }
 
 int bench_speed(SpeedOptions opt) {
+  if (opt.single) {
+    opt.variants = {"reference", "bare", "float"};
+  }
   if (opt.quick) {
     opt.sizes = {16, 32};
     opt.repeats = 1;
@@ -694,10 +742,16 @@ void add_bench_speed_command(CLI::App& bench) {
       ->check(CLI::Range(1, 1024));
   speed->add_option("--csv", o.csv, "Write one row per measurement to this CSV file");
   // A misspelt variant is an error, not an empty table.
-  speed->add_option("--variants", o.variants, "Variants to measure (default: all)")
-      ->delimiter(',')
-      ->check(CLI::IsMember({"reference", "readable", "naive", "bare", "kernel", "+aerodynamics",
-                             "+aerodynamics+ground", "implicit", "student"}));
+  CLI::Option* variants =
+      speed->add_option("--variants", o.variants, "Variants to measure (default: all)")
+          ->delimiter(',')
+          ->check(CLI::IsMember({"reference", "float", "readable", "naive", "bare", "kernel",
+                                 "+aerodynamics", "+aerodynamics+ground", "implicit", "student"}));
+  speed
+      ->add_flag("--float", o.single,
+                 "The float rows (the step in single precision, [engine] precision = \"float\") "
+                 "and the double rows they are compared with: --variants reference,bare,float")
+      ->excludes(variants);
   speed->add_flag("--quick", o.quick, "Sizes 16 and 32, one short repeat (for tests)");
   speed->add_flag("--no-student", o.no_student, "Do not run clothlab-student");
   speed->callback([] {

@@ -37,6 +37,7 @@
 #include "clothlab/core/not_implemented.hpp"
 #include "clothlab/core/stop.hpp"
 #include "clothlab/integrators/implicit_euler.hpp"
+#include "fast/float_room.hpp"
 #include "io/files.hpp"
 #include "io/output.hpp"
 #include "io/run.hpp"
@@ -315,6 +316,11 @@ int main(int argc, char** argv) {
   run_cmd->add_flag("--readable", readable,
                     "Take the lecture's path alone, without the fast path (as [engine] fast_path "
                     "= false): the same result, slower; --stats then times each effect");
+  bool use_float = false;
+  run_cmd->add_flag("--float", use_float,
+                    "Step in single precision in the engine room (as [engine] precision = "
+                    "\"float\"): the Euler methods with gravity, springs, bending, damping, "
+                    "contacts and moving pins; close to the double run, not its bits");
   int threads = -1;
   run_cmd
       ->add_option("--threads", threads,
@@ -362,6 +368,12 @@ int main(int argc, char** argv) {
       if (threads >= 0)
         scene.world.threads = threads > 0 ? threads : ThreadTeam::hardware_threads();
       if (readable) scene.world.backend.reset();
+      if (use_float) {
+        if (const std::string why = fast::use_float(scene.world); !why.empty()) {
+          fmt::print(stderr, "error: --float: {}\n", why);
+          return app::kExitBadInput;  // as a scene the run cannot take
+        }
+      }
       return run(scene, outputs, stats);
     }
     if (*validate_cmd) {

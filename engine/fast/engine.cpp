@@ -6,6 +6,7 @@
 #include "clothlab/after_step/ground_collision.hpp"
 #include "clothlab/core/world.hpp"
 #include "clothlab/integrators/euler.hpp"
+#include "fast/float_room.hpp"
 
 namespace clothlab::fast {
 
@@ -83,12 +84,7 @@ bool FastEngine::prepare(const World& world) {
   bool any = false;
   for (size_t e = 0; e < effects.size(); ++e) {
     Force& force = forces_[e];
-    const ForceEffect& effect = *effects[e];
-    if (force.effect != &effect || *force.type != typeid(effect)) {
-      force.effect = &effect;
-      force.type = &typeid(effect);
-      force.fast = fast_force(effect);
-    }
+    force.match(*effects[e], fast_force);
     force.on = force.fast && force.fast->prepare(world.particles);
     any = any || force.on;
   }
@@ -111,6 +107,10 @@ bool FastEngine::sum_forces(const World& world, const Matrix3X& x, const Matrix3
 }
 
 BackendStep FastEngine::step(World& world, double dt) {
+  if (precision == Precision::float32) {
+    if (!float_room_) float_room_ = std::make_shared<FloatRoom>();
+    return float_room_->step(world, dt);
+  }
   // Only the Euler methods move each particle by its own force alone, after one evaluation.
   const Integrator* integrator = world.integrator.get();
   const bool explicit_euler = dynamic_cast<const ExplicitEuler*>(integrator) != nullptr;

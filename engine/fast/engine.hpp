@@ -40,6 +40,9 @@
 //
 // Of a VBD step it takes the sweeps (vbd.cpp): colour by colour, each colour split over the
 // threads, with the bits of the integrator's own loop.
+//
+// With `[engine] precision = "float"` it hands each step to the float room (float_room.hpp): the
+// same pass in single precision, for the Euler methods and the effects listed there.
 #pragma once
 
 #include <functional>
@@ -73,6 +76,7 @@ inline constexpr Index kPassBlock = 8192;
 
 struct ImplicitSolver;
 struct LocalGlobalRoom;  // local_global.cpp
+class FloatRoom;         // float_room.hpp
 
 class FastEngine final : public Backend {
  public:
@@ -94,6 +98,13 @@ class FastEngine final : public Backend {
   // the lecture's solver is). SPEED.md measures what the blocks save.
   enum class Preconditioner { diagonal, block_jacobi };
   Preconditioner implicit_preconditioner = Preconditioner::block_jacobi;
+
+  // The numbers a step computes with: double (the fast path above, bit for bit the readable
+  // path), or float (`[engine] precision = "float"`): every step in the float room
+  // (float_room.hpp), which covers the Euler methods and the effects it lists, and throws on
+  // anything else. Force sums asked for outside a step (sum_forces) stay double.
+  enum class Precision { float64, float32 };
+  Precision precision = Precision::float64;
 
   bool sum_forces(const World& world, const Matrix3X& x, const Matrix3X& v, Matrix3X& f) override;
   BackendStep step(World& world, double dt) override;
@@ -146,14 +157,8 @@ class FastEngine final : public Backend {
   void pass(const World& world, const Matrix3X& x, const Matrix3X& v, Matrix3X& f,
             const MoveRange* move = nullptr, PassChecks* checks = nullptr);
 
-  struct Force {
-    // The world's effect at this place, and its type: an effect removed and another made at the
-    // same address is seen as new unless it is of the same type (and then the fast form reads
-    // the new one, and checks its version).
-    const ForceEffect* effect = nullptr;
-    const std::type_info* type = nullptr;
-    std::unique_ptr<FastForce> fast;  // its fast form, or null
-    bool on = false;                  // it takes the current evaluation
+  struct Force : FastForceSlot<double> {
+    bool on = false;  // it takes the current evaluation
   };
   std::vector<Force> forces_;
   struct Contact {  // a leading post-step effect that rides along in a step's pass
@@ -172,6 +177,7 @@ class FastEngine final : public Backend {
   std::shared_ptr<ImplicitSolver> implicit_;  // implicit Euler's arrays (implicit.cpp)
   // The local/global solver's factor and buffers (local_global.cpp), made on its first step.
   std::shared_ptr<LocalGlobalRoom> local_global_;
+  std::shared_ptr<FloatRoom> float_room_;  // made on the first step in float
 };
 
 // A world's fast engine: what a scene installs as World::backend.

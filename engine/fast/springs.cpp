@@ -33,8 +33,10 @@
 #include <algorithm>
 #include <cstdint>
 #include <cstring>
+#include <type_traits>
 
 #include "fast/forces.hpp"
+#include "fast/scalar_kernels.hpp"
 #include "fast/vectorise.hpp"
 
 namespace clothlab::fast {
@@ -75,18 +77,20 @@ namespace {
 // A function of its own, not inlined, so that every pointer can be declared not to overlap the
 // others: then the compiler vectorises the loop, kernel inlined. With Uniform, ks[0] and kd[0]
 // serve every spring: read once, outside the loop, instead of two more numbers per spring.
-template <bool Uniform>
-[[gnu::noinline]] void forces_of_run(Index count, Index nx, Index nv, const double* __restrict x1,
-                                     const double* __restrict x2, const double* __restrict v1,
-                                     const double* __restrict v2, const double* __restrict ks,
+// S is the scalar of the copies: double on the fast path (the exercise's kernel), float in the
+// float room (spring_kernel, scalar_kernels.hpp); the constants are the set's doubles.
+template <class S, bool Uniform>
+[[gnu::noinline]] void forces_of_run(Index count, Index nx, Index nv, const S* __restrict x1,
+                                     const S* __restrict x2, const S* __restrict v1,
+                                     const S* __restrict v2, const double* __restrict ks,
                                      const double* __restrict kd, const double* __restrict l0,
-                                     double* __restrict f1x, double* __restrict f1y,
-                                     double* __restrict f1z) {
+                                     S* __restrict f1x, S* __restrict f1y, S* __restrict f1z) {
+  using V = Vec3Of<S>;
   for (Index t = 0; t < count; ++t) {
-    const Vec3 f1 = spring_damper_force(
-        Vec3(x1[t], x1[nx + t], x1[2 * nx + t]), Vec3(x2[t], x2[nx + t], x2[2 * nx + t]),
-        Vec3(v1[t], v1[nv + t], v1[2 * nv + t]), Vec3(v2[t], v2[nv + t], v2[2 * nv + t]),
-        ks[Uniform ? 0 : t], kd[Uniform ? 0 : t], l0[t]);
+    const V f1 =
+        spring_kernel(V(x1[t], x1[nx + t], x1[2 * nx + t]), V(x2[t], x2[nx + t], x2[2 * nx + t]),
+                      V(v1[t], v1[nv + t], v1[2 * nv + t]), V(v2[t], v2[nv + t], v2[2 * nv + t]),
+                      ks[Uniform ? 0 : t], kd[Uniform ? 0 : t], l0[t]);
     f1x[t] = f1.x();
     f1y[t] = f1.y();
     f1z[t] = f1.z();
@@ -98,8 +102,9 @@ template <bool Uniform>
 void spring_forces_of_run(Index count, Index nx, Index nv, const double* x1, const double* x2,
                           const double* v1, const double* v2, const double* ks, const double* kd,
                           const double* l0, double* f1x, double* f1y, double* f1z, bool uniform) {
-  (uniform ? forces_of_run<true> : forces_of_run<false>)(count, nx, nv, x1, x2, v1, v2, ks, kd, l0,
-                                                         f1x, f1y, f1z);
+  (uniform ? forces_of_run<double, true> : forces_of_run<double, false>)(count, nx, nv, x1, x2, v1,
+                                                                         v2, ks, kd, l0, f1x, f1y,
+                                                                         f1z);
 }
 
 namespace {
@@ -120,23 +125,23 @@ constexpr Index kChunk = 256;  // springs per chunk: f1 of a chunk takes 6 KiB
 // +f1 to the i end and -f1 to the j end. f_upper and f_lower point into the same array,
 // kDirectGap or more apart, which is why they are not restrict. `flatten` asks for the kernel
 // inlined at link time, as in forces_of_run: for these twelve instances GCC declines otherwise.
-template <bool Uniform, bool UpperIsJ, bool ToUpper, bool ToLower>
+template <class S, bool Uniform, bool UpperIsJ, bool ToUpper, bool ToLower>
 [[gnu::noinline, gnu::flatten]] void run_kernel_direct(
-    Index count, Index nx, Index nv, Index n, const double* __restrict x1,
-    const double* __restrict x2, const double* __restrict v1, const double* __restrict v2,
-    const double* __restrict ks, const double* __restrict kd, const double* __restrict l0,
-    double* f_upper, double* f_lower) {
+    Index count, Index nx, Index nv, Index n, const S* __restrict x1, const S* __restrict x2,
+    const S* __restrict v1, const S* __restrict v2, const double* __restrict ks,
+    const double* __restrict kd, const double* __restrict l0, S* f_upper, S* f_lower) {
+  using V = Vec3Of<S>;
   // No two springs the compiler takes at once touch the same particle (see kDirectGap).
   CLOTHLAB_INDEPENDENT_ITERATIONS
   for (Index t = 0; t < count; ++t) {
-    const Vec3 f1 = spring_damper_force(
-        Vec3(x1[t], x1[nx + t], x1[2 * nx + t]), Vec3(x2[t], x2[nx + t], x2[2 * nx + t]),
-        Vec3(v1[t], v1[nv + t], v1[2 * nv + t]), Vec3(v2[t], v2[nv + t], v2[2 * nv + t]),
-        ks[Uniform ? 0 : t], kd[Uniform ? 0 : t], l0[t]);
+    const V f1 =
+        spring_kernel(V(x1[t], x1[nx + t], x1[2 * nx + t]), V(x2[t], x2[nx + t], x2[2 * nx + t]),
+                      V(v1[t], v1[nv + t], v1[2 * nv + t]), V(v2[t], v2[nv + t], v2[2 * nv + t]),
+                      ks[Uniform ? 0 : t], kd[Uniform ? 0 : t], l0[t]);
     // The i end gets +f1, the j end -f1. Component by component, written out: the compiler
     // keeps f1 in registers only if no loop index picks its components.
-    double* const f_i = UpperIsJ ? f_lower : f_upper;
-    double* const f_j = UpperIsJ ? f_upper : f_lower;
+    S* const f_i = UpperIsJ ? f_lower : f_upper;
+    S* const f_j = UpperIsJ ? f_upper : f_lower;
     if constexpr (UpperIsJ ? ToLower : ToUpper) {
       f_i[t] += f1.x();
       f_i[n + t] += f1.y();
@@ -153,10 +158,11 @@ template <bool Uniform, bool UpperIsJ, bool ToUpper, bool ToLower>
 
 // f[c][t] += f1[c][t] (add) or -= (subtract), for t = 0 .. count - 1 and each component c;
 // f's components are n apart, f1's kChunk apart.
-void add_shares(Index count, Index n, const double* __restrict f1, double* __restrict f, bool add) {
+template <class S>
+void add_shares(Index count, Index n, const S* __restrict f1, S* __restrict f, bool add) {
   for (int c = 0; c < 3; ++c) {
-    double* __restrict fc = f + c * n;
-    const double* __restrict f1c = f1 + c * kChunk;
+    S* __restrict fc = f + c * n;
+    const S* __restrict f1c = f1 + c * kChunk;
     if (add) {
       for (Index t = 0; t < count; ++t)
         fc[t] += f1c[t];
@@ -172,12 +178,13 @@ void add_shares(Index count, Index n, const double* __restrict f1, double* __res
 // gap], for t = 0 .. count - 1 (- then + when the upper ends are the j ends). Two passes would
 // read back, one to three places over, a value just stored by a vector instruction, which the
 // processor cannot forward from its store buffer: a stall on every load.
-void add_both_shares(Index count, Index n, Index gap, const double* __restrict f1,
-                     double* __restrict f, bool upper_is_j) {
+template <class S>
+void add_both_shares(Index count, Index n, Index gap, const S* __restrict f1, S* __restrict f,
+                     bool upper_is_j) {
   for (int c = 0; c < 3; ++c) {
-    double* __restrict fc = f + c * n;
-    const double* __restrict up = f1 + c * kChunk;
-    const double* __restrict lo = up + gap;
+    S* __restrict fc = f + c * n;
+    const S* __restrict up = f1 + c * kChunk;
+    const S* __restrict lo = up + gap;
     if (upper_is_j) {
       for (Index t = 0; t < count; ++t)
         fc[t] = (fc[t] - up[t]) + lo[t];
@@ -193,8 +200,13 @@ void add_both_shares(Index count, Index n, Index gap, const double* __restrict f
 namespace {
 
 // SpringDampers::add_forces on the copies, run by run. The runs are cut again whenever the set's
-// ends or constants change (SpringSet::version), checked before every evaluation.
-class FastSprings final : public FastForce {
+// ends or constants change (SpringSet::version), checked before every evaluation. S: the copies'
+// scalar (double: the fast path; float: the float room).
+template <class S>
+class FastSprings final : public FastForceOf<S> {
+ public:
+  using SoA = SoA3Of<S>;
+
  public:
   explicit FastSprings(const SpringDampers& springs) : springs_(springs) {}
 
@@ -206,12 +218,13 @@ class FastSprings final : public FastForce {
       built_ = true;
     }
     // Runs of a few springs cost more in bookkeeping than they save: such a set (springs given
-    // one by one, or shuffled) is left to add_forces.
+    // one by one, or shuffled) is left to add_forces. The float room has no add_forces in float
+    // to leave it to: there every set goes run by run, runs of one spring included.
     constexpr size_t kMinMeanRun = 8;
-    return s.size() >= kMinMeanRun * runs_.size();
+    return std::is_same_v<S, float> || s.size() >= kMinMeanRun * runs_.size();
   }
 
-  void add(const Particles& /*p*/, const SoA3& x, const SoA3& v, SoA3& f, Index begin,
+  void add(const Particles& /*p*/, const SoA& x, const SoA& v, SoA& f, Index begin,
            Index end) const override {
     for (const SpringRun& run : runs_)
       add_run(run, begin, end, x, v, f);
@@ -219,12 +232,12 @@ class FastSprings final : public FastForce {
 
  private:
   // Adds the forces of the springs of `run` on the particles [p_begin, p_end) to f.
-  void add_run(const SpringRun& run, Index p_begin, Index p_end, const SoA3& x, const SoA3& v,
-               SoA3& f) const;
+  void add_run(const SpringRun& run, Index p_begin, Index p_end, const SoA& x, const SoA& v,
+               SoA& f) const;
   // The same for a run whose ends are kDirectGap or more apart, without the buffer: springs
   // [up_begin, up_end) have their upper end in range, [lo_begin, lo_end) their lower end.
   void add_run_direct(const SpringRun& run, Index up_begin, Index up_end, Index lo_begin,
-                      Index lo_end, const SoA3& x, const SoA3& v, SoA3& f) const;
+                      Index lo_end, const SoA& x, const SoA& v, SoA& f) const;
 
   const SpringDampers& springs_;
   std::vector<SpringRun> runs_;
@@ -232,8 +245,9 @@ class FastSprings final : public FastForce {
   unsigned long version_ = 0;
 };
 
-void FastSprings::add_run(const SpringRun& run, Index p_begin, Index p_end, const SoA3& x,
-                          const SoA3& v, SoA3& f) const {
+template <class S>
+void FastSprings<S>::add_run(const SpringRun& run, Index p_begin, Index p_end, const SoA& x,
+                             const SoA& v, SoA& f) const {
   const Index n = f.cols();  // the stride of f's rows (of x's: x.cols(), of v's: v.cols())
   const Index lower = std::min(run.i0, run.j0), upper = std::max(run.i0, run.j0);
   const auto in_run = [&](Index t) { return std::clamp<Index>(t, 0, run.length); };
@@ -248,15 +262,18 @@ void FastSprings::add_run(const SpringRun& run, Index p_begin, Index p_end, cons
   const Index first = up_begin < up_end ? up_begin : lo_begin;
   const Index last = lo_begin < lo_end ? lo_end : up_end;
   const bool upper_is_j = run.j0 > run.i0;
-  double f1[3 * kChunk];
+  S f1[3 * kChunk];
   for (Index c0 = first; c0 < last; c0 += kChunk) {
     const Index c1 = std::min(c0 + kChunk, last);
     const Index k = static_cast<Index>(run.k0) + c0;
-    spring_forces_of_run(c1 - c0, x.cols(), v.cols(), x.data() + run.i0 + c0,
-                         x.data() + run.j0 + c0, v.data() + run.i0 + c0, v.data() + run.j0 + c0,
-                         springs_.springs().ks().data() + k, springs_.springs().kd().data() + k,
-                         springs_.springs().l0().data() + k, f1, f1 + kChunk, f1 + 2 * kChunk,
-                         run.uniform);
+    (run.uniform ? forces_of_run<S, true>
+                 : forces_of_run<S, false>)(c1 - c0, x.cols(), v.cols(), x.data() + run.i0 + c0,
+                                            x.data() + run.j0 + c0, v.data() + run.i0 + c0,
+                                            v.data() + run.j0 + c0,
+                                            springs_.springs().ks().data() + k,
+                                            springs_.springs().kd().data() + k,
+                                            springs_.springs().l0().data() + k, f1, f1 + kChunk,
+                                            f1 + 2 * kChunk);
     // Springs [u0, u1) of the chunk give upper ends their shares, [l0, l1) lower ends theirs.
     // Upper end upper + t is lower end lower + t + gap: where both fall in this chunk, that
     // particle takes both at once (upper first); the others take theirs one pass at a time.
@@ -264,8 +281,8 @@ void FastSprings::add_run(const SpringRun& run, Index p_begin, Index p_end, cons
     const Index u0 = std::max(c0, up_begin), u1 = std::min(c1, up_end);
     const Index l0 = std::max(c0, lo_begin), l1 = std::min(c1, lo_end);
     const Index both0 = std::max(u0, l0 - gap), both1 = std::max(both0, std::min(u1, l1 - gap));
-    double* const f_upper = f.data() + upper;
-    double* const f_lower = f.data() + lower;
+    S* const f_upper = f.data() + upper;
+    S* const f_lower = f.data() + lower;
     const auto upper_only = [&](Index t0, Index t1) {
       if (t0 < t1) add_shares(t1 - t0, n, f1 + (t0 - c0), f_upper + t0, !upper_is_j);
     };
@@ -287,30 +304,32 @@ void FastSprings::add_run(const SpringRun& run, Index p_begin, Index p_end, cons
   }
 }
 
-void FastSprings::add_run_direct(const SpringRun& run, Index up_begin, Index up_end, Index lo_begin,
-                                 Index lo_end, const SoA3& x, const SoA3& v, SoA3& f) const {
+template <class S>
+void FastSprings<S>::add_run_direct(const SpringRun& run, Index up_begin, Index up_end,
+                                    Index lo_begin, Index lo_end, const SoA& x, const SoA& v,
+                                    SoA& f) const {
   const Index lower = std::min(run.i0, run.j0), upper = std::max(run.i0, run.j0);
   const bool upper_is_j = run.j0 > run.i0;
   // Springs [t0, t1) of the run, their forces added to the ends that are in range.
   const auto springs = [&](Index t0, Index t1, bool to_upper, bool to_lower) {
     if (t0 >= t1) return;
     const Index k = static_cast<Index>(run.k0) + t0;
-    // run_kernel_direct<Uniform, UpperIsJ, ToUpper, ToLower> by
+    // run_kernel_direct<S, Uniform, UpperIsJ, ToUpper, ToLower> by
     // [uniform][upper_is_j][to_upper][to_lower].
-    using Kernel = decltype(&run_kernel_direct<false, false, true, true>);
+    using Kernel = decltype(&run_kernel_direct<S, false, false, true, true>);
     static constexpr Kernel kernels[2][2][2][2] = {
-        {{{nullptr, run_kernel_direct<false, false, false, true>},
-          {run_kernel_direct<false, false, true, false>,
-           run_kernel_direct<false, false, true, true>}},
-         {{nullptr, run_kernel_direct<false, true, false, true>},
-          {run_kernel_direct<false, true, true, false>,
-           run_kernel_direct<false, true, true, true>}}},
-        {{{nullptr, run_kernel_direct<true, false, false, true>},
-          {run_kernel_direct<true, false, true, false>,
-           run_kernel_direct<true, false, true, true>}},
-         {{nullptr, run_kernel_direct<true, true, false, true>},
-          {run_kernel_direct<true, true, true, false>,
-           run_kernel_direct<true, true, true, true>}}}};
+        {{{nullptr, run_kernel_direct<S, false, false, false, true>},
+          {run_kernel_direct<S, false, false, true, false>,
+           run_kernel_direct<S, false, false, true, true>}},
+         {{nullptr, run_kernel_direct<S, false, true, false, true>},
+          {run_kernel_direct<S, false, true, true, false>,
+           run_kernel_direct<S, false, true, true, true>}}},
+        {{{nullptr, run_kernel_direct<S, true, false, false, true>},
+          {run_kernel_direct<S, true, false, true, false>,
+           run_kernel_direct<S, true, false, true, true>}},
+         {{nullptr, run_kernel_direct<S, true, true, false, true>},
+          {run_kernel_direct<S, true, true, true, false>,
+           run_kernel_direct<S, true, true, true, true>}}}};
     kernels[run.uniform][upper_is_j][to_upper][to_lower](
         t1 - t0, x.cols(), v.cols(), f.cols(), x.data() + run.i0 + t0, x.data() + run.j0 + t0,
         v.data() + run.i0 + t0, v.data() + run.j0 + t0, springs_.springs().ks().data() + k,
@@ -328,8 +347,11 @@ void FastSprings::add_run_direct(const SpringRun& run, Index up_begin, Index up_
 
 }  // namespace
 
-std::unique_ptr<FastForce> fast_springs(const SpringDampers& springs) {
-  return std::make_unique<FastSprings>(springs);
+template <class Scalar>
+std::unique_ptr<FastForceOf<Scalar>> fast_springs(const SpringDampers& springs) {
+  return std::make_unique<FastSprings<Scalar>>(springs);
 }
+template std::unique_ptr<FastForceOf<double>> fast_springs(const SpringDampers&);
+template std::unique_ptr<FastForceOf<float>> fast_springs(const SpringDampers&);
 
 }  // namespace clothlab::fast

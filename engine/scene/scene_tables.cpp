@@ -26,6 +26,7 @@
 #include "clothlab/integrators/methods.hpp"
 #include "clothlab/integrators/vbd.hpp"
 #include "clothlab/integrators/xpbd.hpp"
+#include "fast/float_room.hpp"
 
 namespace clothlab {
 
@@ -970,6 +971,14 @@ void read_engine(SceneTable& t, Scene& scene) {
   const long threads = t.integer("threads", 0, 1024, world.threads);
   world.threads = threads > 0 ? static_cast<int>(threads) : ThreadTeam::hardware_threads();
   if (!t.boolean("fast_path", true)) world.backend.reset();
+  // The numbers the engine room computes with (fast/float_room.hpp). Read last of the scene's
+  // tables: float covers some methods and effects only, and says so here.
+  if (t.choice("precision", {"double", "float"}, "double") == "float") {
+    if (const std::string why = fast::use_float(world); !why.empty()) {
+      t.fail("precision",
+             fmt::format("precision = \"float\": {}; expected precision = \"double\"", why));
+    }
+  }
 }
 
 // The order here is the order of reading: the guard's bounds, which the particles must start
@@ -1025,7 +1034,7 @@ constexpr std::array kKinds = {
                    "[integrator] with method, dt [s] and duration [s]", read_integrator},
     SceneTableKind{"output", false, false, "fps velocities springs format", "[output] with fps",
                    read_output},
-    SceneTableKind{"engine", false, false, "threads fast_path", "[engine] with threads",
+    SceneTableKind{"engine", false, false, "threads fast_path precision", "[engine] with threads",
                    read_engine},
 };
 

@@ -1,0 +1,157 @@
+// float_room.cpp: a step of an Euler method in single precision (float_room.hpp).
+#include "fast/float_room.hpp"
+
+#include <algorithm>
+#include <atomic>
+#include <stdexcept>
+
+#include "clothlab/after_step/ground_collision.hpp"
+#include "clothlab/after_step/moving_pins.hpp"
+#include "clothlab/core/world.hpp"
+#include "clothlab/integrators/euler.hpp"
+#include "fast/engine.hpp"
+#include "fast/scalar_kernels.hpp"
+
+namespace clothlab::fast {
+
+namespace {
+
+// Particles [begin, end) moved by their own forces in float, from the float copies (component c
+// of particle i at x[c nx + i]), into the engine's layout (x, y, z side by side, in doubles):
+// x_out and v_out the new state, f_out the forces the step summed, as the fast path leaves them.
+// A function of its own so that its pointers can be declared not to overlap: the compiler then
+// takes several particles at once.
+template <bool Symplectic>
+[[gnu::noinline]] void move_in_float(Index begin, Index end, float dt, const float* __restrict x,
+                                     Index nx, const float* __restrict v, Index nv,
+                                     const float* __restrict f, Index nf,
+                                     const double* __restrict inv_m, double* __restrict x_out,
+                                     double* __restrict v_out, double* __restrict f_out) {
+  for (Index i = begin; i < end; ++i) {
+    const Vec3f fi(f[i], f[nf + i], f[2 * nf + i]);
+    const Vec3f xi(x[i], x[nx + i], x[2 * nx + i]);
+    const Vec3f vi(v[i], v[nv + i], v[2 * nv + i]);
+    const float inv_mi = static_cast<float>(inv_m[i]);
+    // Not const, as in the fast path's move: GCC 12 does not split a const aggregate.
+    PointStateOf<float> next = Symplectic ? symplectic_euler(xi, vi, fi, inv_mi, dt)
+                                          : explicit_euler(xi, vi, fi, inv_mi, dt);
+    for (int c = 0; c < 3; ++c) {
+      x_out[3 * i + c] = next.r[c];
+      v_out[3 * i + c] = next.v[c];
+      f_out[3 * i + c] = fi[c];
+    }
+  }
+}
+
+// The names of `effects` the float room does not cover, comma-separated, given what it covers.
+template <class Effects, class Covered>
+std::string uncovered(const Effects& effects, Covered covered) {
+  std::string names;
+  for (const auto& effect : effects) {
+    if (covered(*effect)) continue;
+    if (!names.empty()) names += ", ";
+    names += effect->name();
+  }
+  return names;
+}
+
+// The methods and the post-step effects the float room covers.
+bool covered(const Integrator* integrator) {
+  return !integrator || dynamic_cast<const SymplecticEuler*>(integrator) ||
+         dynamic_cast<const ExplicitEuler*>(integrator);
+}
+bool covered(const PostStepEffect& effect) {
+  return dynamic_cast<const Ground*>(&effect) || dynamic_cast<const Plane*>(&effect) ||
+         dynamic_cast<const Sphere*>(&effect) || dynamic_cast<const MovingPins*>(&effect);
+}
+
+}  // namespace
+
+std::string float_room_declines(const World& world) {
+  std::string why;
+  if (!covered(world.integrator.get())) why = "the method " + std::string(world.integrator->name());
+  std::string effects = uncovered(world.force_effects, [](const ForceEffect& effect) {
+    return fast_force_float(effect) != nullptr;
+  });
+  const std::string after = uncovered(world.post_step_effects,
+                                      [](const PostStepEffect& effect) { return covered(effect); });
+  if (!after.empty()) effects += (effects.empty() ? "" : ", ") + after;
+  if (!effects.empty()) {
+    why += (why.empty() ? "" : " and ") +
+           std::string(effects.find(',') == std::string::npos ? "the effect " : "the effects ") +
+           effects;
+  }
+  return why;
+}
+
+std::string use_float(World& world) {
+  auto* engine = dynamic_cast<FastEngine*>(world.backend.get());
+  if (!engine) {
+    return "float runs in the engine room, and this world has none (fast_path = false, "
+           "--readable): the readable engine computes in double only";
+  }
+  if (const std::string why = float_room_declines(world); !why.empty())
+    return "float covers " + std::string(kFloatCovers) + "; this scene has " + why;
+  engine->precision = FastEngine::Precision::float32;
+  return "";
+}
+
+BackendStep FloatRoom::step(World& world, double dt) {
+  // Each force effect's float form, made again only for an effect not seen at this place. A
+  // world that holds something not covered (added since the scene loaded) stops here.
+  const auto& effects = world.force_effects;
+  forces_.resize(effects.size());
+  bool all_covered = covered(world.integrator.get());
+  for (size_t e = 0; e < effects.size(); ++e) {
+    forces_[e].match(*effects[e], fast_force_float);
+    all_covered = all_covered && forces_[e].fast;
+  }
+  for (const auto& effect : world.post_step_effects)
+    all_covered = all_covered && covered(*effect);
+  if (!all_covered) {
+    throw std::logic_error("precision = \"float\" covers " + std::string(kFloatCovers) +
+                           "; this world has " + float_room_declines(world));
+  }
+  Particles& p = world.particles;
+  for (const FastForceSlot<float>& force : forces_)
+    force.fast->prepare(p);  // float spring forms take every set (springs.cpp)
+  const bool symplectic = dynamic_cast<const SymplecticEuler*>(world.integrator.get()) != nullptr;
+  const Index n = p.size();
+  CopiesOf<float>& c = copies_;
+  c.resize(n);
+  p.f.resize(3, n);
+  // 1. x and v rounded into the copies, checked for the guard as they go; f cleared.
+  std::atomic<bool> start_within = true;
+  world.for_particles([&](Index begin, Index end) {
+    const bool x_within =
+        to_soa_within(begin, end, p.x.data(), c.x.data(), c.x.cols(), world.guard.max_position);
+    const bool v_within =
+        to_soa_within(begin, end, p.v.data(), c.v.data(), c.v.cols(), world.guard.max_speed);
+    if (!x_within || !v_within) start_within = false;
+    c.f.middleCols(begin, end - begin).setZero();
+  });
+  if (!start_within) world.guard.check(world, /*before_step=*/true);
+  // 2-3. Block by block, as the fast path's pass (FastEngine::pass): every effect adds its
+  // forces on the block, then the block moves, and is checked.
+  const float h = static_cast<float>(dt);
+  const auto move = symplectic ? move_in_float<true> : move_in_float<false>;
+  std::atomic<bool> end_within = true;
+  world.for_particles([&](Index begin, Index end) {
+    for (Index b0 = begin; b0 < end; b0 += kPassBlock) {
+      const Index b1 = std::min(b0 + kPassBlock, end);
+      for (const FastForceSlot<float>& force : forces_)
+        force.fast->add(p, c.x, c.v, c.f, b0, b1);
+      for (Index c0 = b0; c0 < b1; c0 += kPassChunk) {
+        const Index c1 = std::min(c0 + kPassChunk, b1);
+        move(c0, c1, h, c.x.data(), c.x.cols(), c.v.data(), c.v.cols(), c.f.data(), c.f.cols(),
+             p.inv_m.data(), p.x.data(), p.v.data(), p.f.data());
+        if (!world.guard.within(p.x, p.v, c0, c1)) end_within = false;
+      }
+    }
+  });
+  ++world.force_evaluations;
+  ++world.backend_evaluations;
+  return {true, 0, end_within};
+}
+
+}  // namespace clothlab::fast
