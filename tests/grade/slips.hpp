@@ -6,14 +6,16 @@
 #include <cmath>
 #include <initializer_list>
 #include <string>
+#include <vector>
 
 #include "clothlab/core/types.hpp"
 
 namespace grading {
 
 // A wrong answer and what it means: the value the slip gives for the case's inputs, and the slip
-// in words. Most kernels return a Vec3; a case whose answer is a number, a count or a step count
-// lists SlipOf<double> or SlipOf<int> instead, and the same hint picks among them.
+// in words. Most kernels return a Vec3; a case whose answer is a number, a count or a list of
+// positions lists SlipOf<double>, SlipOf<int> or SlipOf<std::vector<std::size_t>> instead, and the
+// same hint picks among them.
 template <typename T>
 struct SlipOf {
   T value;
@@ -29,6 +31,10 @@ inline bool same_answer(double a, double b, double tol) {
   return std::abs(a - b) <= tol;
 }
 inline bool same_answer(int a, int b, double /*tol*/) {
+  return a == b;
+}
+inline bool same_answer(const std::vector<std::size_t>& a, const std::vector<std::size_t>& b,
+                        double /*tol*/) {
   return a == b;
 }
 
@@ -186,6 +192,15 @@ inline const std::initializer_list<SlipOf<double>> kClampBelow = {
     {0.72,
      "the clamp taken around l0 (it is [l_built (1 - max_strain), l_built (1 + max_strain)])"},
     {1.0 / 3.0, "the clamp forgotten (the rest length must stay within max_strain of l_built)"}};
+
+// ex06.2, strains {1.2, 3.0, 0.1, 2.5, 1.8, 2.9, 1.3} over tear_strain = 1 with max_tears = 3:
+// the three most strained, positions 1 (3.0), 5 (2.9) and 3 (2.5), ascending [1, 3, 5]. The first
+// three over the limit: [0, 1, 3]; the three least strained (the ranking turned around), 0 (1.2),
+// 6 (1.3) and 4 (1.8): [0, 4, 6]; the most strained in the order of their ranking: [1, 5, 3].
+inline const std::initializer_list<SlipOf<std::vector<std::size_t>>> kTearCap = {
+    {{0, 1, 3}, "the first max_tears springs over the limit, not the most strained"},
+    {{0, 4, 6}, "the least strained kept (rank the most strained first)"},
+    {{1, 5, 3}, "the positions left in the order of the ranking (return them ascending)"}};
 
 // ex07.1, a = -4 x, dt = 0.1 s, x = 1 m, v = 0.5 m/s: (x', v') = (1.03, 0.09), written (x', v', 0).
 // Plain Euler (1 + 0.05, 0.5 - 0.4) = (1.05, 0.1); a2 at the full Euler step (x2 = 1.05, v2 = 0.1,
