@@ -9,15 +9,9 @@
 #   ? an extended regular expression that a line of the grader's output must match (optional,
 #     any number: the hint a lesson promises for this mistake, say)
 #
-# a copy of solutions/FILE with that one line changed: it must compile and lose points on exercise
-# exNN.k (a grading case that still gives full marks cannot tell the mistake from the right
-# answer), and each "?" must match a line of what the grader prints about exNN.k. Grading costs
-# more than compiling one file (a grade starts the build, the kernels and a process a case), so
-# mutants of different files are planted together: round k holds the k-th mutant of each file
-# (as many rounds as the file with the most mutants has), graded once on every exercise. Each
-# mutant is still judged on its own exercise, its "?" lines against that exercise's lines of the
-# output alone, and every exercise of the round with no mutant must keep full marks (a mistake
-# that cost points in another file's exercise would make the round's verdicts unsound);
+# a copy of solutions/FILE with that one line changed, graded on exercise exNN.k alone: it must
+# compile and lose points there (a grading case that still gives full marks cannot tell the
+# mistake from the right answer);
 #
 #   submission NAME: what its kernels do
 #   region FILE exNN.k
@@ -55,28 +49,6 @@ if(count GREATER 0)
 endif()
 message("${score} ${max}${scored}")
 CMAKE
-
-# The points of each exercise in results.json, one line "exNN.k score max" each, summed over its
-# cases.
-cat >"$work/exercise_results.cmake" <<'CMAKE'
-file(READ ${RESULTS} json)
-string(JSON count LENGTH "${json}" tests)
-if(count GREATER 0)
-  math(EXPR last "${count} - 1")
-  foreach(i RANGE ${last})
-    string(JSON name GET "${json}" tests ${i} name)
-    string(JSON got GET "${json}" tests ${i} score)
-    string(JSON points GET "${json}" tests ${i} max_score)
-    string(REGEX MATCH "^ex[0-9][0-9]\\.[0-9]+" exercise "${name}")
-    message("${exercise} ${got} ${points}")
-  endforeach()
-endif()
-CMAKE
-exercise_points() {
-  cmake -DRESULTS="$1" -P "$work/exercise_results.cmake" 2>&1 |
-    awk '{ score[$1] += $2; max[$1] += $3 } END { for (e in max) print e, score[e], max[e] }' |
-    sort
-}
 
 # grade NAME ARGS...: grades the folder $work/NAME in one scratch folder (as an instructor grades
 # a class in turn, so that an unchanged file is not compiled again); sets score, max and scored.
@@ -184,61 +156,21 @@ for entry in "${submissions[@]}"; do
 done
 
 # --- grade them --------------------------------------------------------------------------------
-# Rounds: the k-th mutant of each file goes into round k, a copy of solutions/ with the mutants'
-# files in place of theirs.
-declare -A round_of_file  # FILE -> how many of its mutants have a round
-rounds=0
-declare -A round_mutants  # round -> its mutants' entries, one a line
 for entry in "${mutants[@]}"; do
   IFS='|' read -r name exercise what <<<"$entry"
-  file=$(basename "$(ls "$work/$name"/[0-9][0-9]_*.cpp)")
-  k=$((${round_of_file[$file]:-0} + 1))
-  round_of_file[$file]=$k
-  ((k > rounds)) && rounds=$k
-  if [[ ! -d $work/round-$k ]]; then
-    mkdir -p "$work/round-$k"
-    cp "$source_dir"/solutions/[0-9][0-9]_*.cpp "$work/round-$k/"
+  echo "== $name, $exercise: $what"
+  grade "$name" --exercise "$exercise" || continue
+  echo "   $score / $max points$([[ -n $scored ]] && printf '%s' ", scored by:"$'\n'"$scored")"
+  if [[ $max -eq 0 ]]; then
+    problem "$name ($exercise): no cases were graded"
+  elif [[ $score -ge $max ]]; then
+    problem "$name ($exercise: $what) keeps full marks, $score / $max"
   fi
-  cp "$work/$name/$file" "$work/round-$k/"
-  round_mutants[$k]+="$entry"$'\n'
-done
-for ((k = 1; k <= rounds; ++k)); do
-  echo "== round $k of $rounds:$(while IFS='|' read -r name exercise what; do
-    [[ -n $name ]] && printf ' %s' "$exercise"
-  done <<<"${round_mutants[$k]}")"
-  # A round of one mutant (the last rounds of the file with the most) is graded on its exercise.
-  only=()
-  if [[ $(grep -c . <<<"${round_mutants[$k]}") -eq 1 ]]; then
-    only=(--exercise "$(cut -d'|' -f2 <<<"${round_mutants[$k]}" | head -1)")
-  fi
-  if ! grade "round-$k" "${only[@]}"; then
-    problem "round $k: not graded, so none of its mutants was judged"
-    continue
-  fi
-  points=$(exercise_points "$work/round-$k.json")
-  planted_here=" "
-  while IFS='|' read -r name exercise what; do
-    [[ -z $name ]] && continue
-    planted_here+="$exercise "
-    read -r _ score max <<<"$(grep "^$exercise " <<<"$points" || true)" || true
-    echo "   $name, $exercise: $what: ${score:-no} / ${max:-no} points"
-    if [[ -z $max || $max -eq 0 ]]; then
-      problem "$name ($exercise): no cases were graded"
-    elif [[ $score -ge $max ]]; then
-      problem "$name ($exercise: $what) keeps full marks, $score / $max"
-    fi
-    # The grader's lines about this exercise: its row and the indented lines under it.
-    lines=$(awk -v ex="$exercise " '/^[^ ]/ { inside = index($0, ex) == 1 } inside' <<<"$out")
-    while IFS= read -r pattern; do
-      [[ -z $pattern ]] && continue
-      grep -Eq -- "$pattern" <<<"$lines" ||
-        problem "$name ($exercise: $what): no line of the grader's output about $exercise matches \"$pattern\""
-    done <<<"${expect_lines[$name]:-}"
-  done <<<"${round_mutants[$k]}"
-  while read -r exercise score max; do
-    [[ $planted_here == *" $exercise "* || $score -eq $max ]] ||
-      problem "round $k: $exercise, where nothing was planted, scores $score / $max: a mutant of another file costs it points, so the round cannot judge its mutants apart"
-  done <<<"$points"
+  while IFS= read -r pattern; do
+    [[ -z $pattern ]] && continue
+    grep -Eq -- "$pattern" <<<"$out" ||
+      problem "$name ($exercise: $what): no line of the grader's output matches \"$pattern\""
+  done <<<"${expect_lines[$name]:-}"
 done
 for entry in "${submissions[@]}"; do
   IFS='|' read -r name what <<<"$entry"
