@@ -151,6 +151,16 @@ TEST_SUITE("ex06") {
     // flow_rate = 10 1/s, dt = 0.03 s: the fraction is flow_rate dt = 0.3.
     const PlasticLimits limits{0.25, 10.0, 0.5};
     {
+      // First, as it tells the usual slips apart: flow_rate = 2 1/s, dt = 0.05 s, fraction 0.1,
+      // l0' = 2 + 0.1 (2.4 - 2) = 2.04. (flow_rate alone would give 2.8 and dt alone 2.02.)
+      const double r = clothlab::plastic_rest_length(3.0, 2.0, 2.0, {0.25, 2.0, 0.5}, 0.05);
+      // What the usual slips give here is worked out in slips.hpp (kFlowFraction).
+      INFO(grading::hint(r, grading::slips::kFlowFraction, 1e-9,
+                         "the fraction is the product flow_rate dt = 2 * 0.05 = 0.1, so l0' = "
+                         "2.04: neither flow_rate nor dt alone"));
+      CHECK(r == doctest::Approx(2.04).epsilon(1e-12));
+    }
+    {
       // Stretched to 3: target 2.4, l0' = 2 + 0.3 (2.4 - 2) = 2.12.
       const double r = clothlab::plastic_rest_length(3.0, 2.0, 2.0, limits, 0.03);
       INFO(
@@ -165,15 +175,6 @@ TEST_SUITE("ex06") {
           "a compressed spring flows the same fraction toward its own target: "
           "l0' = 2 + 0.3 (1.6 - 2) = 1.88");
       CHECK(r == doctest::Approx(1.88).epsilon(1e-12));
-    }
-    {
-      // flow_rate = 2 1/s, dt = 0.05 s: fraction 0.1, l0' = 2 + 0.1 (2.4 - 2) = 2.04. (Using
-      // flow_rate alone would give 2.8 and dt alone 2.02.)
-      const double r = clothlab::plastic_rest_length(3.0, 2.0, 2.0, {0.25, 2.0, 0.5}, 0.05);
-      INFO(
-          "the fraction is the product flow_rate dt = 2 * 0.05 = 0.1, so l0' = 2.04: neither "
-          "flow_rate nor dt alone");
-      CHECK(r == doctest::Approx(2.04).epsilon(1e-12));
     }
   }
 
@@ -252,9 +253,10 @@ TEST_SUITE("ex06") {
       // Already compressed for good to l0 = 0.9, now squeezed to l = 0.3: strain = -2/3,
       // target = 0.3 / 0.9 = 0.333..., clamped to l_built (1 - 0.2) = 0.8. (Around l0: 0.72.)
       const double r = clothlab::plastic_rest_length(0.3, 0.9, 1.0, limits, 1.0);
-      INFO(
-          "clamp around l_built, not l0: a spring built at 1 m with max_strain 0.2 never gets a "
-          "rest length below 0.8 m");
+      // What the usual slips give here is worked out in slips.hpp (kClampBelow).
+      INFO(grading::hint(r, grading::slips::kClampBelow, 1e-9,
+                         "clamp around l_built, not l0: a spring built at 1 m with max_strain 0.2 "
+                         "never gets a rest length below 0.8 m"));
       CHECK(r == doctest::Approx(0.8).epsilon(1e-12));
     }
     {
@@ -334,11 +336,12 @@ TEST_SUITE("ex06") {
     const std::vector<size_t> one = clothlab::select_tears(strain, ends, 1.0, 1);
     {
       // The three most strained: positions 1, 5 and 3, returned ascending: [1, 3, 5].
-      INFO(
-          "with max_tears = 3 only the 3 most strained springs tear (strains 3.0, 2.9, 2.5), "
-          "not the first 3 over the limit; return positions in ascending order; expected "
-          "[1, 3, 5], got "
-          << show(three));
+      // What the usual slips give here is worked out in slips.hpp (kTearCap).
+      INFO(grading::hint(three, grading::slips::kTearCap, 0.0,
+                         "with max_tears = 3 only the 3 most strained springs tear (strains 3.0, "
+                         "2.9, 2.5), not the first 3 over the limit; return positions in ascending "
+                         "order; expected [1, 3, 5], got " +
+                             show(three)));
       CHECK(strictly_ascending(three));
       CHECK(three == std::vector<size_t>{1, 3, 5});
     }

@@ -9,7 +9,9 @@
 //   dx = H^-1 f;   dx = 0 for a pinned vertex (w_i = 0) and for a singular H.
 // The numbers are chosen so that every value is a short decimal: most cases take m_i = 1 kg
 // (w_i = 1) and h = 0.1 s, so that m_i / h^2 = 100 N/m.
+#include <algorithm>
 #include <cmath>
+#include <initializer_list>
 #include <limits>
 #include <sstream>
 #include <string>
@@ -53,15 +55,19 @@ struct Vertex {
 };
 
 // Checks the kernel's f, H and dx for `v` against the values worked out by hand, and on failure
-// says what the vertex was (`given`), what was expected, what came back, and `hint`.
+// says what the vertex was (`given`), what was expected, what came back, and `hint`, after the
+// slip the step dx is, if it is one of `slips` (worked out in slips.hpp).
 void check_vertex(const std::string& given, const Vertex& v, const Vec3& f, const Mat3& H,
-                  const Vec3& dx, const std::string& hint = "") {
+                  const Vec3& dx, const std::string& hint = "",
+                  std::initializer_list<grading::Slip> slips = {}) {
   const VertexBlock b =
       clothlab::vbd_vertex_block(v.x_i, v.x_i_start, v.y_i, v.w_i, v.h, v.springs);
   const Vec3 step = clothlab::vbd_vertex_step(v.x_i, v.x_i_start, v.y_i, v.w_i, v.h, v.springs);
-  INFO(given << ": f must be " << grading::show(f) << ", H = " << show(H)
-             << ", dx = " << grading::show(dx) << "; got f = " << grading::show(b.f)
-             << ", H = " << show(b.H) << ", dx = " << grading::show(step) << hint);
+  std::ostringstream said;
+  said << given << ": f must be " << grading::show(f) << ", H = " << show(H)
+       << ", dx = " << grading::show(dx) << "; got f = " << grading::show(b.f)
+       << ", H = " << show(b.H) << ", dx = " << grading::show(step) << hint;
+  INFO(grading::hint(step, slips, 1e-12 * std::max(1.0, dx.norm()), said.str()));
   const double scale = H.cwiseAbs().maxCoeff();
   CHECK_NEAR_VEC(b.f, f, 1e-10 * std::max(1.0, f.norm()));
   CHECK(((b.H - H).cwiseAbs().array() <= 1e-10 * scale).all());
@@ -105,7 +111,8 @@ TEST_SUITE("ex14") {
         "the spring, ks (1 - l0/l) across it, plus m/h^2)",
         {x, x, 1.0, 0.1, {spring_to(Vec3::Zero(), 100.0, 1.0)}}, Vec3(-50.0, 0.0, 0.0),
         diag(200.0, 100.0 + 100.0 / 3.0, 100.0 + 100.0 / 3.0), Vec3(-0.25, 0.0, 0.0),
-        ". A dx of (+0.25, 0, 0) pushes the vertex away: check the signs of f and H");
+        ". A dx of (+0.25, 0, 0) pushes the vertex away: check the signs of f and H",
+        grading::slips::kVbdStretched);
   }
 
   TEST_CASE("ex14.1 two springs at a right angle add their forces and stiffnesses" * POINTS(2)) {
@@ -138,7 +145,8 @@ TEST_SUITE("ex14") {
         {Vec3(0.5, 0.0, 0.0), Vec3(0.5, 0.1, 0.0), 2.0, 0.1, {spring_to(Vec3::Zero(), 100.0, 1.0)}},
         Vec3(50.0, 5.0, 0.0), diag(150.0, 50.0, 50.0), Vec3(1.0 / 3.0, 0.1, 0.0),
         ". An H of diag(150, -50, -50) and a dx with y = -0.1 (away from y_i) is the unclamped "
-        "Hessian: a compressed spring must not make H indefinite");
+        "Hessian: a compressed spring must not make H indefinite",
+        grading::slips::kVbdSqueezed);
   }
 
   TEST_CASE("ex14.1 the damper acts on the pair's motion over the step" * POINTS(2)) {
@@ -154,7 +162,8 @@ TEST_SUITE("ex14") {
         "x_i = y_i = (1, 0, 0), moved from (0.9, 0, 0) this step, one spring at its rest length "
         "to x_j = 0 with ks = 100 N/m, kd = 2 N s/m, h = 0.1 s, m = 1 kg",
         {x, x, 1.0, 0.1, {{Vec3::Zero(), Vec3::Zero(), 100.0, 2.0, 1.0}}, start},
-        Vec3(-2.0, 0.0, 0.0), diag(220.0, 100.0, 100.0), Vec3(-1.0 / 110.0, 0.0, 0.0));
+        Vec3(-2.0, 0.0, 0.0), diag(220.0, 100.0, 100.0), Vec3(-1.0 / 110.0, 0.0, 0.0), "",
+        grading::slips::kVbdDamper);
     check_vertex(
         "the same, with x_j moved by the same (0.1, 0, 0) from (-0.1, 0, 0): no relative motion",
         {x, x, 1.0, 0.1, {{Vec3::Zero(), Vec3(-0.1, 0.0, 0.0), 100.0, 2.0, 1.0}}, start},

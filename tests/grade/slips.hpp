@@ -3,27 +3,49 @@
 // velocity moved the particle"), not only in numbers. grading::hint picks the one an answer is.
 #pragma once
 
+#include <cmath>
 #include <initializer_list>
 #include <string>
+#include <vector>
 
 #include "clothlab/core/types.hpp"
 
 namespace grading {
 
 // A wrong answer and what it means: the value the slip gives for the case's inputs, and the slip
-// in words.
-struct Slip {
-  clothlab::Vec3 value;
+// in words. Most kernels return a Vec3; a case whose answer is a number, a count or a list of
+// positions lists SlipOf<double>, SlipOf<int> or SlipOf<std::vector<std::size_t>> instead, and the
+// same hint picks among them.
+template <typename T>
+struct SlipOf {
+  T value;
   const char* words;
 };
+using Slip = SlipOf<clothlab::Vec3>;
+
+// Whether an answer is a slip's value: each component within tol, or the same count.
+inline bool same_answer(const clothlab::Vec3& a, const clothlab::Vec3& b, double tol) {
+  return ((a - b).cwiseAbs().array() <= tol).all();
+}
+inline bool same_answer(double a, double b, double tol) {
+  return std::abs(a - b) <= tol;
+}
+inline bool same_answer(int a, int b, double /*tol*/) {
+  return a == b;
+}
+inline bool same_answer(const std::vector<std::size_t>& a, const std::vector<std::size_t>& b,
+                        double /*tol*/) {
+  return a == b;
+}
 
 // The case's hint: the slip `got` is (to within tol), named first, then the hint that holds
 // whatever the answer. A case that names slips chooses inputs where each slip gives a value of
 // its own, and none the right one.
-inline std::string hint(const clothlab::Vec3& got, std::initializer_list<Slip> slips, double tol,
-                        const std::string& general) {
-  for (const Slip& s : slips) {
-    if (((got - s.value).cwiseAbs().array() <= tol).all())
+template <typename T>
+std::string hint(const T& got, std::initializer_list<SlipOf<T>> slips, double tol,
+                 const std::string& general) {
+  for (const SlipOf<T>& s : slips) {
+    if (same_answer(got, s.value, tol))
       return std::string("your answer is what ") + s.words + " gives: " + general;
   }
   return general;
@@ -104,6 +126,178 @@ inline const std::initializer_list<Slip> kStrainPinned = {
     {Vec3(1.5, 0.0, 2.0),
      "the correction split evenly: the pinned particle moved half way (its share is w1 / (w1 + "
      "w2) = 0)"}};
+
+// ex03.1, a still right triangle of legs 1 m (n* = (0, 0, 1), a0 = 0.5 m^2) in a wind
+// v_air = (0, 0, -10): v = (0, 0, 10), f = -1/2 * 1.2 * 100 * 1 * 0.5 n = (0, 0, -30) N. The wind
+// not subtracted leaves v = 0: no force. Added (v = v_air), or the sign of f flipped: +30. The
+// area |n*| for |n*| / 2: -60. |v| for |v|^2 (the folded form without its |v|): -3.
+inline const std::initializer_list<Slip> kAeroHeadOn = {
+    {Vec3(0.0, 0.0, 0.0), "the wind not subtracted (v = (v1 + v2 + v3) / 3 - v_air)"},
+    {Vec3(0.0, 0.0, 30.0), "a flipped sign (f = -1/2 rho |v|^2 cd a n), or the wind added"},
+    {Vec3(0.0, 0.0, -60.0), "the area taken as |n*| (the triangle's area is a0 = |n*| / 2)"},
+    {Vec3(0.0, 0.0, -3.0), "|v| where |v|^2 belongs (the folded form is |v| (v . n*) n*)"}};
+
+// ex03.2, rho = 1.2, cd = 0.5, a = 0.1 m^2, u = (3, 0, 4), |u| = 5: f = -0.03 |u| u =
+// (-0.45, 0, -0.6) N. A flipped sign +0.45, +0.6; |u| e for |u|^2 e, -0.03 u / |u| * 5 = -0.15 e =
+// (-0.09, 0, -0.12); |u|^2 u (a squared norm for the norm), -0.03 * 25 u = (-2.25, 0, -3); no 1/2,
+// (-0.9, 0, -1.2).
+inline const std::initializer_list<Slip> kParticleDrag = {
+    {Vec3(0.45, 0.0, 0.6), "a flipped sign (drag points against u)"},
+    {Vec3(-0.09, 0.0, -0.12), "|u| where |u|^2 belongs"},
+    {Vec3(-2.25, 0.0, -3.0), "|u|^2 u, a squared norm for the norm (|u|^2 e = |u| u)"},
+    {Vec3(-0.9, 0.0, -1.2), "the 1/2 left out (f = -1/2 rho |u|^2 cd a e)"}};
+
+// ex04.1, the number of bending pairs of a 4 x 5 grid: 4 * 3 + 5 * 2 = 22. Each pair added from
+// both ends, 44; the pairs one apart (the structural springs), 4 * 4 + 5 * 3 = 31; both loops one
+// short (c + 3 < cols), 4 * 2 + 5 * 1 = 13; rows wrapping into the next (i + 2 < 20 for the row
+// pairs), 18 + 10 = 28.
+inline const std::initializer_list<SlipOf<int>> kBendingCount4x5 = {
+    {44, "each pair added twice, once from each end"},
+    {31, "pairs one apart (those are the structural springs)"},
+    {13, "loops that stop one short (c + 2 < cols allows the last pair)"},
+    {28, "row pairs that wrap into the next row (test c + 2 < cols, not i + 2 < rows cols)"}};
+
+// ex05.1, falling at (0, -4, 0) onto y = 0 with e = 0.5, no friction: v' = (0, 2, 0). v_n kept
+// with its sign, e v_n: (0, -2, 0); e left out, -v_n: (0, 4, 0); no bounce at all: (0, -4, 0).
+inline const std::initializer_list<Slip> kBounce = {
+    {Vec3(0.0, -2.0, 0.0), "v_n scaled by e but not reversed (v_n' = -e v_n)"},
+    {Vec3(0.0, 4.0, 0.0), "e left out: a perfectly elastic bounce (v_n' = -e v_n)"},
+    {Vec3(0.0, -4.0, 0.0), "the velocity left as it was (nothing bounced)"}};
+
+// ex05.1, v = (3, -2, 4), e = 0.5, mu_s = 0.2, mu_d = 0.1: j = 3 m/s, |v_t| = 5, v' = (2.82, 1,
+// 3.76). v_t (1 - mu_d j) = 0.7 v_t: (2.1, 1, 2.8); v_t (1 - mu_d): (2.7, 1, 3.6); mu_d / j in
+// place of mu_d j, 1 - 0.1 / 3 / 5 = 0.99333...: (2.98, 1, 3.97333...); no friction: (3, 1, 4).
+inline const std::initializer_list<Slip> kDynamicFriction = {
+    {Vec3(2.1, 1.0, 2.8), "v_t scaled by (1 - mu_d j), not by (1 - mu_d j / |v_t|)"},
+    {Vec3(2.7, 1.0, 3.6), "v_t scaled by (1 - mu_d): friction must take mu_d j off the slide"},
+    {Vec3(2.98, 1.0, 4.0 * (1.0 - 0.1 / 15.0)),
+     "mu_d / j in place of mu_d j (dynamic friction grows with the impulse j)"},
+    {Vec3(3.0, 1.0, 4.0), "friction left out of a fast slide"}};
+
+// ex06.1, l = 3, l0 = l_built = 2, yield_strain = 0.25 (target 3 / 1.25 = 2.4), flow_rate = 2 1/s,
+// dt = 0.05 s: the fraction flow_rate dt = 0.1 gives l0' = 2.04. dt alone: 2 + 0.05 * 0.4 = 2.02;
+// flow_rate alone, not capped at 1: 2 + 2 * 0.4 = 2.8; a fraction of 1 (flow_rate / dt = 40, or
+// flow_rate alone, capped at 1): the whole way, 2.4.
+inline const std::initializer_list<SlipOf<double>> kFlowFraction = {
+    {2.02, "dt alone as the fraction (it is flow_rate dt)"},
+    {2.8, "flow_rate alone as the fraction (it is flow_rate dt, at most 1)"},
+    {2.4,
+     "a full flow to the target: the fraction came out 1 (flow_rate / dt, or flow_rate "
+     "alone, capped at 1; it is flow_rate dt = 0.1)"}};
+
+// ex06.1, built at 1 m with max_strain 0.2, l0 = 0.9, squeezed to 0.3 with a full flow: the target
+// 0.3 / 0.9 = 0.333... is clamped to l_built (1 - 0.2) = 0.8. Around l0: 0.9 * 0.8 = 0.72; no
+// clamp: 1/3.
+inline const std::initializer_list<SlipOf<double>> kClampBelow = {
+    {0.72,
+     "the clamp taken around l0 (it is [l_built (1 - max_strain), l_built (1 + max_strain)])"},
+    {1.0 / 3.0, "the clamp forgotten (the rest length must stay within max_strain of l_built)"}};
+
+// ex06.2, strains {1.2, 3.0, 0.1, 2.5, 1.8, 2.9, 1.3} over tear_strain = 1 with max_tears = 3:
+// the three most strained, positions 1 (3.0), 5 (2.9) and 3 (2.5), ascending [1, 3, 5]. The first
+// three over the limit: [0, 1, 3]; the three least strained (the ranking turned around), 0 (1.2),
+// 6 (1.3) and 4 (1.8): [0, 4, 6]; the most strained in the order of their ranking: [1, 5, 3].
+inline const std::initializer_list<SlipOf<std::vector<std::size_t>>> kTearCap = {
+    {{0, 1, 3}, "the first max_tears springs over the limit, not the most strained"},
+    {{0, 4, 6}, "the least strained kept (rank the most strained first)"},
+    {{1, 5, 3}, "the positions left in the order of the ranking (return them ascending)"}};
+
+// ex07.1, a = -4 x, dt = 0.1 s, x = 1 m, v = 0.5 m/s: (x', v') = (1.03, 0.09), written (x', v', 0).
+// Plain Euler (1 + 0.05, 0.5 - 0.4) = (1.05, 0.1); a2 at the full Euler step (x2 = 1.05, v2 = 0.1,
+// a2 = -4.2): (1 + 0.01, 0.5 - 0.42) = (1.01, 0.08); x moved with v, (1.05, 0.09); with v',
+// (1.009, 0.09); with a2 for v2, (1 - 0.41, 0.09) = (0.59, 0.09).
+inline const std::initializer_list<Slip> kMidpointSpring = {
+    {Vec3(1.05, 0.1, 0.0), "a plain Euler step (a2 and v2 are taken at the half step)"},
+    {Vec3(1.01, 0.08, 0.0), "a2 taken at the full Euler step instead of the half step"},
+    {Vec3(1.05, 0.09, 0.0), "x moved with the start velocity v instead of v2 (x' = x + dt v2)"},
+    {Vec3(1.009, 0.09, 0.0), "x moved with the end velocity v' instead of v2 (x' = x + dt v2)"},
+    {Vec3(0.59, 0.09, 0.0), "the acceleration a2 where the velocity v2 belongs (x' = x + dt v2)"}};
+
+// ex07.2, the same spring: (x', v') = (1.0297333..., 0.0927), written (x', v', 0). The stage
+// velocities sum to 0.5 + 0.3 + 0.295 + 0.094 = 1.189 and the accelerations to -16.278, so equal
+// weights 1/4 give (1 + 0.1 * 1.189 / 4, 0.5 - 0.1 * 16.278 / 4) = (1.029725, 0.09305). The
+// midpoint step gives (1.03, 0.09). a2 used twice in v' (as[1] for as[2]):
+// v' = 0.5 + 0.1/6 (-4 - 8.2 - 8.2 - 4.118) = 0.5 - 2.4518 / 6 = 0.0913666..., x' unchanged.
+inline const std::initializer_list<Slip> kRk4Spring = {
+    {Vec3(1.029725, 0.09305, 0.0), "equal weights 1/4 for the stages (they are 1, 2, 2, 1 over 6)"},
+    {Vec3(1.03, 0.09, 0.0), "the midpoint step (RK4 takes four stages)"},
+    {Vec3(7723.0 / 7500.0, 0.5 - 2.4518 / 6.0, 0.0),
+     "a stage's acceleration used twice in v' (as[1] where as[2] belongs): v' averages a1, a2, a3 "
+     "and a4"}};
+
+// ex08.1, k = 400 N/m, m = 0.25 kg, c = 1 N s/m (underdamped): c / k = 0.0025 s. c / m = 4;
+// k / c = 400; 2 c / k = 0.005; 2 / w with w = sqrt(k / m) = 40, 0.05 (the overdamped formula's
+// limit, or the undamped oscillator's); c / (k m) = 0.01.
+inline const std::initializer_list<SlipOf<double>> kUnderdampedLimit = {
+    {4.0, "c / m (the stiffness k belongs under c: dt = c / k)"},
+    {400.0, "k / c, the quotient upside down (dt = c / k)"},
+    {0.005, "2 c / k, twice the limit (|R|^2 = 1 - dt c/m + dt^2 k/m <= 1 gives dt <= c / k)"},
+    {0.05, "2 / w, a limit without the damper (below critical damping it is c / k)"},
+    {0.01, "c / (k m): the mass cancels out of the underdamped limit"}};
+
+// ex10.1, x = (-0.1, 0.1, 0) with h = 0.25: x / h = (-0.4, 0.4, 0), floor (-1, 0, 0), the cell
+// written as a Vec3. Truncated toward zero (a cast, std::trunc) or rounded: (0, 0, 0); std::ceil:
+// (0, 1, 0).
+inline const std::initializer_list<Slip> kNegativeCell = {
+    {Vec3(0.0, 0.0, 0.0),
+     "-0.4 truncated toward zero (a cast or std::trunc or std::round) in place of std::floor"},
+    {Vec3(0.0, 1.0, 0.0), "std::ceil in place of std::floor"}};
+
+// ex10.2, e = 0.5, w1 = 3, w2 = 1, u = (3, -2, 0) along n = (0, 1, 0): j = 3 m/s, friction takes
+// mu_d j = 0.6 m/s of the 3 m/s slide, du = (-0.6, 3, 0), v1' = -3/4 du = (0.45, -2.25, 0).
+// mu_d / j for mu_d j takes 0.2 / 3 / 3 of u_t: du = (-0.0666..., 3, 0), v1' = (0.05, -2.25, 0);
+// the shares swapped, v1' = -1/4 du = (0.15, -0.75, 0); no friction, du = (0, 3, 0),
+// v1' = (0, -2.25, 0).
+inline const std::initializer_list<Slip> kPairFriction = {
+    {Vec3(0.05, -2.25, 0.0), "mu_d / j in place of mu_d j (dynamic friction grows with j)"},
+    {Vec3(0.15, -0.75, 0.0),
+     "the shares swapped (particle 1 takes w1 / (w1 + w2) of the change: the lighter one more)"},
+    {Vec3(0.0, -2.25, 0.0), "friction left out of a sliding pair"}};
+
+// ex11.1, leftover 0.7 ms and a frame of 1.6 ms at dt = 1 ms: 2 steps, 0.3 ms left, nothing
+// dropped, written (count, leftover, dropped). Steps counted in the frame time alone but the
+// leftover kept from both: (1, 1.3 ms, 0); the old leftover forgotten altogether: (1, 0.6 ms, 0);
+// rounded up (std::ceil), (3, 0, 0).
+inline const std::initializer_list<Slip> kLeftoverCounts = {
+    {Vec3(1.0, 0.0013, 0.0),
+     "steps counted in the frame time alone (count them in leftover + frame_time)"},
+    {Vec3(1.0, 0.0006, 0.0), "the last frame's leftover forgotten (time = leftover + frame_time)"},
+    {Vec3(3.0, 0.0, 0.0), "the steps rounded up (a step is taken only once its time is there)"}};
+
+// ex12.1, iteration 2 of w_i = w_j = 1, alpha_tilde = 1, lambda = -1/3, C = 1/3: delta_lambda =
+// (-1/3 + 1/3) / 3 = 0. Without -alpha_tilde lambda, -1/3 / 3 = -1/9; lambda + delta_lambda
+// returned, -1/3.
+inline const std::initializer_list<SlipOf<double>> kXpbdSecondIteration = {
+    {-1.0 / 9.0, "plain PBD, the term -alpha_tilde lambda left out of delta_lambda (hint 2)"},
+    {-1.0 / 3.0, "lambda + delta_lambda returned (return delta_lambda alone, hint 4)"}};
+
+// ex13.1, x_i - x_j = (0, -3, -4), l = 5, l0 = 2: d = (0, -1.2, -1.6). x_i - x_j itself:
+// (0, -3, -4); x_j - x_i: (0, 1.2, 1.6) for the flip; l0 (x_i - x_j) not divided by l:
+// (0, -6, -8); the unit vector without l0: (0, -0.6, -0.8).
+inline const std::initializer_list<Slip> kLocalDiagonal = {
+    {Vec3(0.0, -3.0, -4.0), "x_i - x_j itself, not rescaled to the rest length l0"},
+    {Vec3(0.0, 1.2, 1.6), "a flipped direction (d points along x_i - x_j)"},
+    {Vec3(0.0, -6.0, -8.0), "l0 (x_i - x_j), not divided by the length l"},
+    {Vec3(0.0, -0.6, -0.8), "the unit direction without the rest length l0"}};
+
+// ex14.1, one spring stretched to l = 1.5 (ks = 100 N/m, l0 = 1 m), m/h^2 = 100 N/m: f = (-50,
+// 0, 0), H = diag(200, 133.3, 133.3), dx = (-0.25, 0, 0). Without m/h^2 in H, H = diag(100, 33.3,
+// 33.3) and dx = (-0.5, 0, 0): the spring snaps back to l0. f or H with its sign turned: (0.25, 0,
+// 0).
+inline const std::initializer_list<Slip> kVbdStretched = {
+    {Vec3(-0.5, 0.0, 0.0),
+     "H without the inertia m/h^2 I (the spring snaps to its rest length as if the vertex weighed "
+     "nothing)"},
+    {Vec3(0.25, 0.0, 0.0), "f or H with its sign turned (the step pushes the vertex away)"}};
+// ex14.1, the squeezed spring: dx = (1/3, 0.1, 0). The factor 1 - l0/l = -1 not clamped makes
+// H = diag(150, -50, -50) and the sideways step 5 / -50 = -0.1.
+inline const std::initializer_list<Slip> kVbdSqueezed = {
+    {Vec3(1.0 / 3.0, -0.1, 0.0),
+     "the unclamped Hessian (max(0, 1 - l0/l) across a squeezed spring, not 1 - l0/l)"}};
+// ex14.1, the damper at its rest length: H = diag(220, 100, 100), dx = (-1/110, 0, 0). The
+// springs' ks S subtracted: H = diag(100 - 100 + 20, 100, 100), dx = -2 / 20 = (-0.1, 0, 0).
+inline const std::initializer_list<Slip> kVbdDamper = {
+    {Vec3(-0.1, 0.0, 0.0), "the springs' stiffness subtracted from H (H += ks S, not -=)"}};
 
 }  // namespace slips
 }  // namespace grading
