@@ -105,8 +105,8 @@ TEST_SUITE("ex11") {
     for (size_t k = 0; k < splits.size(); ++k) {
       double leftover = 0.0;
       const long steps = steps_for(splits[k], dt, leftover);
-      INFO(names[k] << " at dt = 1 ms must take 2000 steps and leave nothing; got " << steps
-                    << " steps and a leftover of " << leftover / dt << " dt");
+      INFO(std::string(names[k]) << " at dt = 1 ms must take 2000 steps and leave nothing; got "
+                                 << steps << " steps and a leftover of " << leftover / dt << " dt");
       CHECK(steps == 2000);
       CHECK(leftover <= 1e-12);
     }
