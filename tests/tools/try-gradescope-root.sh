@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # try-gradescope-root.sh: the Gradescope autograder, tried as Gradescope runs it, in a fresh
-# Debian 12 root. Run by hand (it needs root, the network and about ten minutes); no test runs it.
+# Debian 12 root. Run by hand (it needs root, the network and up to half an hour, most of it
+# setup.sh compiling the engine); no test runs it.
 #
 #   sudo tests/tools/try-gradescope-root.sh [--cache DIR] [--mirror URL] [--fresh] BUILD_DIR
 #
@@ -95,7 +96,9 @@ printf 'deb %s bookworm bookworm-updates main\ndeb %s bookworm-security main\n' 
 say "building the bundle (cmake --build $build --target gradescope-autograder)"
 cmake --build "$build" --parallel "$(nproc)" --target gradescope-autograder >/dev/null
 bundle=$build/gradescope-autograder.zip
-bundle_sum=$(sha256sum "$bundle" | cut -d' ' -f1)
+# What the bundle holds, not the zip's bytes (which carry the time of each export).
+bundle_sum=$(cd "$build/gradescope-autograder" && find . -type f -print0 | sort -z |
+  xargs -0 sha256sum | sha256sum | cut -d' ' -f1)
 g++ -std=c++20 -O2 -Wall -Wextra -Werror -static -o "$cache/forbid_namespaces" \
   "$source_dir/tests/tools/forbid_namespaces.cpp"
 
@@ -185,6 +188,21 @@ for mode in namespaces no-namespaces chroot; do
   cp "$root/autograder/results/results.json" "$results/$mode.json"
   grep -i -E 'warning|sandbox' "$results/$mode.log" | head -5 || echo "(no warning about the sandbox)"
 done
+
+say "without namespaces: what --sandbox on does, and what the user nobody may read"
+# shellcheck disable=SC2016 # expanded in the root
+in_root no-namespaces '
+  cd /autograder/source/clothlab
+  NO_COLOR=1 ./build/clothlab grade --submission /autograder/submission --scratch /tmp/probe \
+    --exercise ex01 --sandbox on 2>&1 | tail -3
+  echo "(exit status ${PIPESTATUS[0]})"
+  for path in tests/grade-hidden build/grade-cases tests/grade exercises; do
+    if setpriv --reuid=65534 --regid=65534 --clear-groups test -r "$path"; then
+      echo "nobody may read $path"
+    else
+      echo "nobody may not read $path"
+    fi
+  done' 2>&1 | tee "$results/no-namespaces-probe.log"
 
 say "the same files graded as the student grades them (clothlab grade, the files in exercises/)"
 # exercises/ as the student has it: the shipped stubs, with the submission's files over them.
