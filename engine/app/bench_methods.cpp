@@ -697,7 +697,10 @@ void speed(const MethodsOptions& opt, const fs::path& out_dir) {
       fmt::print("; 2 threads over 1: Euler {:.2f}, XPBD {:.2f}{}", euler, xpbd,
                  one.grid == 128 ? (euler >= 1.7 && xpbd >= 1.7 ? " (met)" : " (missed)") : "");
       // What bounds two threads: the wakes (each a barrier) a step or an iteration makes, at
-      // their measured cost with nothing to do, and the memory's own speed-up (a stream).
+      // their measured cost with nothing to do, and the memory's own speed-up (a stream). The
+      // gains keep three significant digits: on a small grid of a busy machine the stream's
+      // second thread may wait for a core a thousand times longer than the stream takes, and
+      // two decimals would print that as a gain of 0.00.
       const double springs = static_cast<double>(one.springs);
       const auto most = [&](double ns_per_spring, double wakes) {
         const double t1 = ns_per_spring * springs;
@@ -706,8 +709,8 @@ void speed(const MethodsOptions& opt, const fs::path& out_dir) {
       fmt::print(
           "\n    bound on 2 threads: an Euler step wakes the threads {:.1f} times, an XPBD "
           "iteration {:.1f}, at {:.0f} ns a wake with nothing to do: with the rest split evenly, "
-          "at most {:.2f} and {:.2f} times 1 thread; on this machine a stream gains {:.2f} and "
-          "square roots and divisions alone {:.2f}",
+          "at most {:.2f} and {:.2f} times 1 thread; on this machine a stream gains {:#.3g} and "
+          "square roots and divisions alone {:#.3g}",
           two.euler_wakes, two.xpbd_wakes, two.wake, most(one.euler[1], two.euler_wakes),
           most(one.xpbd_iteration[1], two.xpbd_wakes),
           streaming_ns_per_spring(one.springs, 1) / streaming_ns_per_spring(one.springs, 2),
