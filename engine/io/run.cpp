@@ -12,6 +12,7 @@
 #include <fmt/format.h>
 
 #include "clothlab/core/guard.hpp"
+#include "clothlab/core/kernel_answer.hpp"
 #include "clothlab/core/stop.hpp"
 #include "io/mesh_export.hpp"
 #include "io/output.hpp"
@@ -177,6 +178,12 @@ RunReport run_scene(Scene& scene, const RunOutputs& outputs, const ProgressFn& p
         world.step(scene.dt);
       } catch (const StepAbandoned&) {
         throw RunStopped(StopSignals::received(), frame_step, report.frames, step);
+      } catch (const KernelAnswerError& error) {
+        // An exercise's answer the engine could not use: the run stops as after a blow-up, at
+        // this step, with the frames before it.
+        throw SimulationError(fmt::format("the run stopped in step {} (from t = {:.6g} s): {}",
+                                          step, world.t, error.what()),
+                              step, -1);
       }
       const bool frame_due = step % steps_per_frame == 0 || step == total;
       if (frame_due) write_frame();

@@ -12,6 +12,8 @@
 
 #include <nlohmann/json.hpp>
 
+#include "clothlab/after_step/tearing.hpp"
+#include "clothlab/core/kernel_answer.hpp"
 #include "io/run.hpp"
 #include "scene/scene.hpp"
 
@@ -33,6 +35,25 @@ std::vector<double> numbers(const std::string& csv_row) {
   for (std::string cell; std::getline(in, cell, ',');)
     values.push_back(std::stod(cell));
   return values;
+}
+
+// One particle falling from the origin, a frame every step of 0.01 s, until the guard stops it
+// when it has fallen 1 m.
+clothlab::Scene falls_out() {
+  return clothlab::parse_scene(R"(
+[[particle]]
+position = [0, 0, 0]
+mass = 1
+[gravity]
+[integrator]
+dt = 0.01
+duration = 10
+[output]
+fps = 100
+[guard]
+max_position = 1.0
+)",
+                               "falls-out.toml");
 }
 
 fs::path fresh_dir(const std::string& name) {
@@ -82,20 +103,7 @@ fps = 10
 }
 
 TEST_CASE("run: when the guard stops a run the files hold every frame before it") {
-  clothlab::Scene scene = clothlab::parse_scene(R"(
-[[particle]]
-position = [0, 0, 0]
-mass = 1
-[gravity]
-[integrator]
-dt = 0.01
-duration = 10
-[output]
-fps = 100
-[guard]
-max_position = 1.0
-)",
-                                                "falls-out.toml");
+  clothlab::Scene scene = falls_out();
   // Free fall passes 1 m after sqrt(2 / 9.8) = 0.45 s, at about step 45.
   const fs::path dir = fresh_dir("guard");
   long failed_step = -1;
@@ -284,4 +292,44 @@ duration = 0.2
   clothlab::run_scene(plain, plain_dir);
   CHECK(!fs::exists(plain_dir / "velocities.csv"));
   CHECK(!fs::exists(plain_dir / "springs.csv"));
+}
+
+namespace {
+
+// A post-step effect whose exercise answer is out of range at step 3.
+class BadAnswerAtStep3 final : public clothlab::PostStepEffect {
+ public:
+  std::string_view name() const override { return "bad answer"; }
+  void apply(clothlab::World& world, const clothlab::StepTime& /*time*/) override {
+    if (world.steps + 1 == 3) clothlab::check_tears({5}, 2);
+  }
+};
+
+}  // namespace
+
+TEST_CASE("run: a run stops at the step of a bad answer, with the frames before it") {
+  // An exercise's answer the engine cannot use (clothlab/core/kernel_answer.hpp), at step 3.
+  clothlab::Scene scene = falls_out();
+  scene.world.post_step_effects.push_back(std::make_unique<BadAnswerAtStep3>());
+  const fs::path dir = fresh_dir("kernel-answer");
+  const clothlab::RunOutputs outputs = clothlab::RunOutputs::in(dir);
+  long step = -1;
+  std::string message;
+  try {
+    clothlab::run_scene(scene, outputs);
+  } catch (const clothlab::SimulationError& e) {
+    step = e.step();
+    message = e.what();
+  }
+  CHECK(step == 3);
+  CHECK(message.find("the run stopped in step 3 (from t = 0.02 s): select_tears returned the "
+                     "position 5, but there are 2 springs") != std::string::npos);
+  CHECK(message.find("(exercise ex06.2)") != std::string::npos);
+  // A header and frames 0, 1 and 2 (the start and the two steps before); the page says why it
+  // ends.
+  CHECK(read_lines(dir / "energy.csv").size() == 1 + 3);
+  std::ifstream page(dir / "view.html");
+  const std::string html{std::istreambuf_iterator<char>(page), {}};
+  CHECK(html.find("select_tears returned the position 5") != std::string::npos);
+  fs::remove_all(dir);
 }

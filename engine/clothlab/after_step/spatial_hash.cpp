@@ -2,7 +2,25 @@
 
 #include <algorithm>
 
+#include <fmt/format.h>
+
+#include "clothlab/core/kernel_answer.hpp"
+
 namespace clothlab {
+
+void throw_slot_outside(const Cell& c, std::size_t table_size, std::size_t slot) {
+  // A negative slot computed on signed integers comes back as a size_t near 2^64.
+  const bool negative = slot > (std::size_t{1} << 63);
+  throw KernelAnswerError(
+      "ex10.1",
+      fmt::format("cell_hash(cell ({}, {}, {}), {}) returned the slot {}, but a table of {} slots "
+                  "has slots 0 to {}{}",
+                  c.ix, c.iy, c.iz, table_size, slot, table_size, table_size - 1,
+                  negative ? fmt::format(" ({} as a signed number: compute on std::uint64_t, "
+                                         "where nothing is negative)",
+                                         static_cast<long long>(slot))
+                           : std::string()));
+}
 
 void SpatialHash::build(const Matrix3X& x, double h, double bound) {
   h_ = h;
@@ -24,7 +42,7 @@ void SpatialHash::build(const Matrix3X& x, double h, double bound) {
   // Counting sort: count each slot's particles in starts_[s + 1] ...
   slots_.resize(members_.size());
   for (std::size_t m = 0; m < members_.size(); ++m) {
-    slots_[m] = cell_hash(cells_[m], n_slots);
+    slots_[m] = checked_cell_hash(cells_[m], n_slots);
     ++starts_[slots_[m] + 1];
   }
   // ... so that the prefix sum makes starts_[s] the first entry of slot s ...

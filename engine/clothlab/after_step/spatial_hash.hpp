@@ -50,6 +50,19 @@ Cell cell_of(const Vec3& x, double h);
 // [0, table_size).
 std::size_t cell_hash(const Cell& c, std::size_t table_size);
 
+// Throws KernelAnswerError (kernel_answer.hpp): cell_hash(c, table_size) gave `slot`, which is
+// not below table_size.
+[[noreturn]] void throw_slot_outside(const Cell& c, std::size_t table_size, std::size_t slot);
+
+// cell_hash, checked: a slot outside the table would make the hash read and write outside its
+// arrays, so the engine takes the exercise's answer only when it is below table_size.
+inline std::size_t checked_cell_hash(const Cell& c, std::size_t table_size) {
+  const std::size_t slot = cell_hash(c, table_size);
+  if (slot >= table_size) [[unlikely]]
+    throw_slot_outside(c, table_size, slot);
+  return slot;
+}
+
 // The offsets (dx, dy, dz) of a cell and of the 13 of its 26 neighbours that come after it,
 // ordered by dx, then dy, then dz: the other 13 are met from the other side.
 inline constexpr std::array<std::array<std::int64_t, 3>, 14> kHalfShell = {{
@@ -119,7 +132,7 @@ void SpatialHash::for_each_pair(const Matrix3X& x, double radius, F&& pair) cons
     for (const std::array<std::int64_t, 3>& d : kHalfShell) {
       const Cell nc{c.ix + d[0], c.iy + d[1], c.iz + d[2]};
       const bool same_cell = d[0] == 0 && d[1] == 0 && d[2] == 0;
-      const std::size_t s = cell_hash(nc, n_slots);
+      const std::size_t s = checked_cell_hash(nc, n_slots);
       for (std::size_t e = starts_[s]; e < starts_[s + 1]; ++e) {
         const Index j = entries_[e];
         if (same_cell && j <= i) continue;  // within a cell, each pair once, from its lower index

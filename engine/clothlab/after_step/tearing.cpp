@@ -3,6 +3,9 @@
 #include <algorithm>
 #include <set>
 
+#include <fmt/format.h>
+
+#include "clothlab/core/kernel_answer.hpp"
 #include "clothlab/core/world.hpp"
 #include "clothlab/forces/aerodynamics.hpp"
 #include "clothlab/forces/spring_damper.hpp"
@@ -20,11 +23,27 @@ void Tearing::apply(World& world, const StepTime& /*time*/) {
   }
   std::vector<size_t> torn = select_tears(strain, ends, tear_strain_, max_tears_);
   if (torn.empty()) return;
+  check_tears(torn, s.size());
   // The exercise returns them ascending and once each; make sure of it, so that a slip there
   // cannot leave a chosen spring in the cloth while its triangles go.
   std::sort(torn.begin(), torn.end());
   torn.erase(std::unique(torn.begin(), torn.end()), torn.end());
   tear(world, torn);
+}
+
+void check_tears(const std::vector<size_t>& torn, size_t count) {
+  for (const size_t k : torn) {
+    if (k >= count) {
+      throw KernelAnswerError(
+          "ex06.2",
+          fmt::format("select_tears returned the position {}, but there are {} springs, at "
+                      "positions 0 to {}{}",
+                      k, count, count - 1,
+                      k > count + (size_t{1} << 62)
+                          ? " (a negative number turned into a size_t: check what you subtract)"
+                          : ""));
+    }
+  }
 }
 
 void Tearing::tear(World& world, const std::vector<size_t>& torn) {

@@ -26,6 +26,10 @@ std::vector<size_t> select_tears(const std::vector<double>& strain,
                                  const std::vector<std::pair<Index, Index>>& ends,
                                  double tear_strain, size_t max_tears);
 
+// Throws KernelAnswerError unless every position in `torn` names one of `count` springs (0 to
+// count - 1): what select_tears must return for the engine to remove the springs it names.
+void check_tears(const std::vector<size_t>& torn, size_t count);
+
 // Tears the springs of `springs` past tear_strain after each step, with the bending springs of
 // `bending` (may be null) that span a tear, and the triangles a tear opens in `world.triangles`
 // and in each of `aerodynamics`. The effects it is given live in the same world: they outlive it.

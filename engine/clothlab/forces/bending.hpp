@@ -15,6 +15,13 @@
 namespace clothlab {
 
 // The bending springs of a cloth grid, ks [N/m] and kd [N s/m], rest lengths measured in x.
+// Throws KernelAnswerError (kernel_answer.hpp) if bending_pairs names a particle outside the
+// grid (check_bending_pairs).
 SpringSet bending_springs(const ClothGrid& grid, double ks, double kd, const Matrix3X& x);
+
+// Throws KernelAnswerError unless every pair joins two different particles of a rows x cols
+// grid, numbered 0 to rows cols - 1: what bending_pairs(rows, cols) must return for the engine
+// to read the particles it names.
+void check_bending_pairs(const std::vector<IndexPair>& pairs, Index rows, Index cols);
 
 }  // namespace clothlab
