@@ -234,7 +234,9 @@ struct StepBytes {
 //     writes copies of x, v and f in the structure-of-arrays layout and reads them back (72
 //     bytes, 216 moved if they leave the cache between the two): touched, not counted as moved;
 //   per spring: its l0 (8 bytes); and its ks and kd (16) unless its run is uniform, whose ks and
-//     kd are read once for the run (16 bytes a run).
+//     kd are read once for the run (16 bytes a run). A grid stencil's springs (fast/springs.hpp)
+//     read their ks and kd once (16), and their rest lengths from its distinct rows of them
+//     (8 bytes each) through one offset a row (8).
 StepBytes step_bytes(const World& world) {
   StepBytes b;
   b.particles = static_cast<long>(world.particles.size());
@@ -246,9 +248,17 @@ StepBytes step_bytes(const World& world) {
       b.moved += 8 * p;
       b.touched += 8 * p;
     } else if (const auto* s = dynamic_cast<const SpringDampers*>(effect.get())) {
-      double constants = 8.0 * static_cast<double>(s->springs().size());
-      for (const fast::SpringRun& run : fast::spring_runs(s->springs()))
-        constants += run.uniform ? 16.0 : 16.0 * static_cast<double>(run.length);
+      const fast::SpringLayout layout =
+          fast::spring_layout(s->springs(), fast::spring_runs(s->springs()));
+      double constants = 0.0;
+      for (const fast::SpringRun& run : layout.runs) {
+        const double length = static_cast<double>(run.length);
+        constants += 8.0 * length + (run.uniform ? 16.0 : 16.0 * length);
+      }
+      for (const fast::SpringStencil& stencil : layout.stencils) {
+        constants += 16.0 + 8.0 * static_cast<double>(stencil.l0.size()) +
+                     8.0 * static_cast<double>(stencil.rows);
+      }
       b.springs += static_cast<long>(s->springs().size());
       b.moved += constants;
       b.touched += constants;

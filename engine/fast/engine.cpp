@@ -100,6 +100,14 @@ std::string FastEngine::plan() const {
   return names;
 }
 
+size_t FastEngine::stencil_springs() const {
+  size_t n = 0;
+  for (const Force& force : forces_) {
+    if (force.on) n += force.fast->stencil_springs();
+  }
+  return n;
+}
+
 bool FastEngine::sum_forces(const World& world, const Matrix3X& x, const Matrix3X& v, Matrix3X& f) {
   if (!prepare(world)) return false;
   pass(world, x, v, f);

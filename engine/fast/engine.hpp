@@ -132,6 +132,8 @@ class FastEngine final : public Backend {
   // Which of the world's force effects it summed itself in its last evaluation ("gravity+
   // springs+ buoyancy-"), for tests and for `clothlab bench`.
   std::string plan() const;
+  // Springs of those effects it takes through grid stencils (springs.hpp), as last prepared.
+  size_t stencil_springs() const;
 
   // An update of particles [begin, end) after their forces are summed: it may read f and change
   // the state of those particles only. With `copies`, the copies hold, for those particles, the

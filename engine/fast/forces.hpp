@@ -36,6 +36,10 @@ class FastForceOf {
   // threads take different ranges at once.
   virtual void add(const Particles& p, const SoA3Of<Scalar>& x, const SoA3Of<Scalar>& v,
                    SoA3Of<Scalar>& f, Index begin, Index end) const = 0;
+
+  // Springs it takes through grid stencils (springs.hpp), as prepared last: for tests and the
+  // bench.
+  virtual size_t stencil_springs() const { return 0; }
 };
 using FastForce = FastForceOf<double>;
 

@@ -1,4 +1,4 @@
-// springs.cpp: the fast engine's spring-dampers (SpringDampers), run by run.
+// springs.cpp: the fast engine's spring-dampers (SpringDampers), run by run and stencil by stencil.
 //
 // SpringDampers::add_forces is the lecture's loop: for each spring, f1 from the exercise kernel,
 // added to one end and subtracted from the other. It reads i[k] and j[k] and jumps to wherever they
@@ -24,6 +24,12 @@
 // buffer: each spring's f1 goes straight to both ends (run_kernel_direct below says why the
 // order of the sums stays the same).
 //
+// A grid's rows come as stencils (SpringStencil, springs.hpp): the rows of a family taken one
+// after the other, in the set's order, as the runs they replace would be, each through the same
+// loops as a run (RunView), so the sums are the same, bit for bit. What a stencil saves is the
+// rest lengths' stream: its rows read theirs from a few distinct rows of them, which stay in the
+// first-level cache, and ks and kd once. SPEED.md measures what that is worth.
+//
 // With several threads, each owns a contiguous range of particles and adds only to those: it
 // takes every spring with an end in its range. A spring between two ranges is computed by both
 // threads (the same bits twice); nothing is shared, so there are no locks and no atomics.
@@ -31,8 +37,6 @@
 #include "fast/springs.hpp"
 
 #include <algorithm>
-#include <cstdint>
-#include <cstring>
 #include <type_traits>
 
 #include "fast/forces.hpp"
@@ -40,19 +44,6 @@
 #include "fast/vectorise.hpp"
 
 namespace clothlab::fast {
-namespace {
-
-// The same double, bit for bit: -0.0 and 0.0 differ here, which == would not see, and the fast
-// path must compute a uniform run's springs with their own bits.
-// (memcpy rather than std::bit_cast, which the C++ library of the WebAssembly build lacks.)
-bool same_bits(double a, double b) {
-  std::uint64_t bits_a, bits_b;
-  std::memcpy(&bits_a, &a, sizeof a);
-  std::memcpy(&bits_b, &b, sizeof b);
-  return bits_a == bits_b;
-}
-
-}  // namespace
 
 std::vector<SpringRun> spring_runs(const SpringSet& s) {
   std::vector<SpringRun> runs;
@@ -70,6 +61,110 @@ std::vector<SpringRun> spring_runs(const SpringSet& s) {
     runs.push_back({k, s.i(k), s.j(k), 1, true});
   }
   return runs;
+}
+
+size_t SpringLayout::stencil_springs() const {
+  size_t n = 0;
+  for (const SpringStencil& stencil : stencils)
+    n += stencil.springs();
+  return n;
+}
+
+SpringLayout spring_layout(const SpringSet& s, const std::vector<SpringRun>& runs) {
+  // Whether row b may follow row a in a stencil whose rows are `stride` particles apart (0: any
+  // stride, at least a row's length, so that the rows' springs come in the order of their ends).
+  const auto follows = [&](const SpringRun& a, const SpringRun& b, Index stride) {
+    const Index step = b.i0 - a.i0;
+    return a.uniform && b.uniform && b.length == a.length && b.j0 - b.i0 == a.j0 - a.i0 &&
+           step >= a.length && (stride == 0 || step == stride) &&
+           same_bits(s.ks(b.k0), s.ks(a.k0)) && same_bits(s.kd(b.k0), s.kd(a.k0));
+  };
+  // The grid's width: the stride of the first two runs that form rows. A uniform run of a
+  // multiple of it (two rows or more) is taken as rows of that many springs.
+  Index width = 0;
+  for (size_t a = 0; a + 1 < runs.size() && width == 0; ++a) {
+    if (follows(runs[a], runs[a + 1], 0)) width = runs[a + 1].i0 - runs[a].i0;
+  }
+  std::vector<SpringRun> rows;
+  rows.reserve(runs.size());
+  for (const SpringRun& run : runs) {
+    if (width == 0 || !run.uniform || run.length < 2 * width || run.length % width != 0) {
+      rows.push_back(run);
+      continue;
+    }
+    for (Index r = 0; r < run.length / width; ++r) {
+      const Index t = r * width;
+      rows.push_back({run.k0 + static_cast<size_t>(t), run.i0 + t, run.j0 + t, width, true});
+    }
+  }
+  // Every spring of the row at its built rest length, bit for bit.
+  const auto as_built = [&](const SpringRun& row) {
+    for (size_t k = row.k0; k < row.k0 + static_cast<size_t>(row.length); ++k) {
+      if (!same_bits(s.l0(k), s.l_built(k))) return false;
+    }
+    return true;
+  };
+  // Where the row's rest lengths start among the stencil's distinct rows of them: a new row of
+  // them if there is room, else none.
+  constexpr size_t kNone = static_cast<size_t>(-1);
+  const auto rest_row = [&](SpringStencil& stencil, const SpringRun& row) {
+    const auto l0 = s.l0().begin() + static_cast<std::ptrdiff_t>(row.k0);
+    const auto same = [](double a, double b) { return same_bits(a, b); };
+    const size_t n = static_cast<size_t>(row.length);
+    for (size_t p = 0; p < stencil.l0.size(); p += n) {
+      if (std::equal(l0, l0 + row.length, stencil.l0.begin() + static_cast<std::ptrdiff_t>(p),
+                     same))
+        return p;
+    }
+    if (stencil.l0.size() >= kStencilRestRows * n) return kNone;
+    stencil.l0.insert(stencil.l0.end(), l0, l0 + row.length);
+    return stencil.l0.size() - n;
+  };
+  SpringLayout layout;
+  // A row in no stencil goes to the runs, continuing the last one if it can (the rows of a long
+  // run on either side of a row that left the stencil), though never across a stencil.
+  const auto keep = [&](const SpringRun& row) {
+    const bool after_stencil =
+        !layout.stencils.empty() && layout.stencils.back().runs_before == layout.runs.size();
+    if (!layout.runs.empty() && !after_stencil) {
+      SpringRun& last = layout.runs.back();
+      const Index n = last.length;
+      if (last.k0 + static_cast<size_t>(n) == row.k0 && last.i0 + n == row.i0 &&
+          last.j0 + n == row.j0) {
+        last.uniform = last.uniform && row.uniform && same_bits(s.ks(row.k0), s.ks(last.k0)) &&
+                       same_bits(s.kd(row.k0), s.kd(last.k0));
+        last.length += row.length;
+        return;
+      }
+    }
+    layout.runs.push_back(row);
+  };
+  for (size_t a = 0; a < rows.size();) {
+    const SpringRun& first = rows[a];
+    SpringStencil stencil{first.k0, first.i0, first.j0,          first.length,
+                          0,        1,        s.ks(first.k0),    s.kd(first.k0),
+                          {},       {},       layout.runs.size()};
+    size_t b = a + 1;
+    if (first.uniform && as_built(first)) {
+      stencil.row_l0.push_back(rest_row(stencil, first));  // the first always has room
+      for (; b < rows.size() && follows(rows[b - 1], rows[b], stencil.stride) && as_built(rows[b]);
+           ++b) {
+        const size_t p = rest_row(stencil, rows[b]);
+        if (p == kNone) break;
+        stencil.stride = rows[b].i0 - rows[b - 1].i0;
+        stencil.row_l0.push_back(p);
+      }
+    }
+    if (b - a < 2) {
+      keep(first);
+      ++a;
+      continue;
+    }
+    stencil.rows = static_cast<Index>(b - a);
+    layout.stencils.push_back(std::move(stencil));
+    a = b;
+  }
+  return layout;
 }
 
 namespace {
@@ -199,9 +294,19 @@ void add_both_shares(Index count, Index n, Index gap, const S* __restrict f1, S*
 
 namespace {
 
-// SpringDampers::add_forces on the copies, run by run. The runs are cut again whenever the set's
-// ends or constants change (SpringSet::version), checked before every evaluation. S: the copies'
-// scalar (double: the fast path; float: the float room).
+// The springs of a run, or of one row of a stencil, as the loops below read them: spring t joins
+// particles i0 + t and j0 + t, with constants ks[t], kd[t] (ks[0] and kd[0] if uniform) and
+// l0[t].
+struct RunView {
+  Index i0, j0, length;
+  const double *ks, *kd, *l0;
+  bool uniform;
+};
+
+// SpringDampers::add_forces on the copies, stencil by stencil and run by run (SpringLayout). The
+// layout is cut again whenever the set's ends or constants change (SpringSet::version), or, while
+// it holds stencils, a rest length (SpringSet::rest_version): both are checked before every
+// evaluation. S: the copies' scalar (double: the fast path; float: the float room).
 template <class S>
 class FastSprings final : public FastForceOf<S> {
  public:
@@ -214,8 +319,15 @@ class FastSprings final : public FastForceOf<S> {
     const SpringSet& s = springs_.springs();
     if (!built_ || version_ != s.version()) {
       runs_ = spring_runs(s);
+      layout_ = spring_layout(s, runs_);
       version_ = s.version();
+      rest_version_ = s.rest_version();
       built_ = true;
+    } else if (rest_version_ != s.rest_version()) {
+      // A rest length moved: the springs it left no longer belong in a stencil. Runs read the
+      // set's rest lengths where they are, so a layout without stencils stands as it is.
+      if (!layout_.stencils.empty()) layout_ = spring_layout(s, runs_);
+      rest_version_ = s.rest_version();
     }
     // Runs of a few springs cost more in bookkeeping than they save: such a set (springs given
     // one by one, or shuffled) is left to add_forces. The float room has no add_forces in float
@@ -226,27 +338,64 @@ class FastSprings final : public FastForceOf<S> {
 
   void add(const Particles& /*p*/, const SoA& x, const SoA& v, SoA& f, Index begin,
            Index end) const override {
-    for (const SpringRun& run : runs_)
-      add_run(run, begin, end, x, v, f);
+    // In the set's order: each stencil after the runs that come before it.
+    size_t next = 0;
+    for (const SpringStencil& stencil : layout_.stencils) {
+      for (; next < stencil.runs_before; ++next)
+        add_run(view(layout_.runs[next]), begin, end, x, v, f);
+      add_stencil(stencil, begin, end, x, v, f);
+    }
+    for (; next < layout_.runs.size(); ++next)
+      add_run(view(layout_.runs[next]), begin, end, x, v, f);
   }
 
+  size_t stencil_springs() const override { return layout_.stencil_springs(); }
+
  private:
+  RunView view(const SpringRun& run) const {
+    const SpringSet& s = springs_.springs();
+    return {run.i0,
+            run.j0,
+            run.length,
+            s.ks().data() + run.k0,
+            s.kd().data() + run.k0,
+            s.l0().data() + run.k0,
+            run.uniform};
+  }
   // Adds the forces of the springs of `run` on the particles [p_begin, p_end) to f.
-  void add_run(const SpringRun& run, Index p_begin, Index p_end, const SoA& x, const SoA& v,
+  void add_run(const RunView& run, Index p_begin, Index p_end, const SoA& x, const SoA& v,
                SoA& f) const;
   // The same for a run whose ends are kDirectGap or more apart, without the buffer: springs
   // [up_begin, up_end) have their upper end in range, [lo_begin, lo_end) their lower end.
-  void add_run_direct(const SpringRun& run, Index up_begin, Index up_end, Index lo_begin,
+  void add_run_direct(const RunView& run, Index up_begin, Index up_end, Index lo_begin,
                       Index lo_end, const SoA& x, const SoA& v, SoA& f) const;
+  // The same for the rows of a stencil with an end in range, row after row: the rows come in
+  // the set's order, and a particle meets them in the order add_forces adds them.
+  void add_stencil(const SpringStencil& stencil, Index p_begin, Index p_end, const SoA& x,
+                   const SoA& v, SoA& f) const {
+    const Index lower = std::min(stencil.i0, stencil.j0), upper = std::max(stencil.i0, stencil.j0);
+    // Row r's ends lie in [lower + r stride, upper + r stride + length): the rows that reach
+    // [p_begin, p_end), or a row more (add_run finds it has nothing there).
+    const Index r0 = std::max<Index>(0, (p_begin - upper - stencil.length) / stencil.stride);
+    const Index r1 =
+        p_end <= lower ? 0 : std::min(stencil.rows, (p_end - lower) / stencil.stride + 1);
+    for (Index r = r0; r < r1; ++r) {
+      const Index shift = r * stencil.stride;
+      add_run({stencil.i0 + shift, stencil.j0 + shift, stencil.length, &stencil.ks, &stencil.kd,
+               stencil.l0.data() + stencil.row_l0[static_cast<size_t>(r)], true},
+              p_begin, p_end, x, v, f);
+    }
+  }
 
   const SpringDampers& springs_;
-  std::vector<SpringRun> runs_;
+  std::vector<SpringRun> runs_;  // the set's runs, as spring_runs cuts them
+  SpringLayout layout_;          // and as the fast path takes them
   bool built_ = false;
-  unsigned long version_ = 0;
+  unsigned long version_ = 0, rest_version_ = 0;
 };
 
 template <class S>
-void FastSprings<S>::add_run(const SpringRun& run, Index p_begin, Index p_end, const SoA& x,
+void FastSprings<S>::add_run(const RunView& run, Index p_begin, Index p_end, const SoA& x,
                              const SoA& v, SoA& f) const {
   const Index n = f.cols();  // the stride of f's rows (of x's: x.cols(), of v's: v.cols())
   const Index lower = std::min(run.i0, run.j0), upper = std::max(run.i0, run.j0);
@@ -265,15 +414,12 @@ void FastSprings<S>::add_run(const SpringRun& run, Index p_begin, Index p_end, c
   S f1[3 * kChunk];
   for (Index c0 = first; c0 < last; c0 += kChunk) {
     const Index c1 = std::min(c0 + kChunk, last);
-    const Index k = static_cast<Index>(run.k0) + c0;
+    const Index k = run.uniform ? 0 : c0;  // ks and kd of spring c0 (a uniform run's: of 0)
     (run.uniform ? forces_of_run<S, true>
                  : forces_of_run<S, false>)(c1 - c0, x.cols(), v.cols(), x.data() + run.i0 + c0,
                                             x.data() + run.j0 + c0, v.data() + run.i0 + c0,
-                                            v.data() + run.j0 + c0,
-                                            springs_.springs().ks().data() + k,
-                                            springs_.springs().kd().data() + k,
-                                            springs_.springs().l0().data() + k, f1, f1 + kChunk,
-                                            f1 + 2 * kChunk);
+                                            v.data() + run.j0 + c0, run.ks + k, run.kd + k,
+                                            run.l0 + c0, f1, f1 + kChunk, f1 + 2 * kChunk);
     // Springs [u0, u1) of the chunk give upper ends their shares, [l0, l1) lower ends theirs.
     // Upper end upper + t is lower end lower + t + gap: where both fall in this chunk, that
     // particle takes both at once (upper first); the others take theirs one pass at a time.
@@ -305,7 +451,7 @@ void FastSprings<S>::add_run(const SpringRun& run, Index p_begin, Index p_end, c
 }
 
 template <class S>
-void FastSprings<S>::add_run_direct(const SpringRun& run, Index up_begin, Index up_end,
+void FastSprings<S>::add_run_direct(const RunView& run, Index up_begin, Index up_end,
                                     Index lo_begin, Index lo_end, const SoA& x, const SoA& v,
                                     SoA& f) const {
   const Index lower = std::min(run.i0, run.j0), upper = std::max(run.i0, run.j0);
@@ -313,7 +459,7 @@ void FastSprings<S>::add_run_direct(const SpringRun& run, Index up_begin, Index 
   // Springs [t0, t1) of the run, their forces added to the ends that are in range.
   const auto springs = [&](Index t0, Index t1, bool to_upper, bool to_lower) {
     if (t0 >= t1) return;
-    const Index k = static_cast<Index>(run.k0) + t0;
+    const Index k = run.uniform ? 0 : t0;  // ks and kd of spring t0 (a uniform run's: of 0)
     // run_kernel_direct<S, Uniform, UpperIsJ, ToUpper, ToLower> by
     // [uniform][upper_is_j][to_upper][to_lower].
     using Kernel = decltype(&run_kernel_direct<S, false, false, true, true>);
@@ -332,8 +478,7 @@ void FastSprings<S>::add_run_direct(const SpringRun& run, Index up_begin, Index 
            run_kernel_direct<S, true, true, true, true>}}}};
     kernels[run.uniform][upper_is_j][to_upper][to_lower](
         t1 - t0, x.cols(), v.cols(), f.cols(), x.data() + run.i0 + t0, x.data() + run.j0 + t0,
-        v.data() + run.i0 + t0, v.data() + run.j0 + t0, springs_.springs().ks().data() + k,
-        springs_.springs().kd().data() + k, springs_.springs().l0().data() + k,
+        v.data() + run.i0 + t0, v.data() + run.j0 + t0, run.ks + k, run.kd + k, run.l0 + t0,
         f.data() + upper + t0, f.data() + lower + t0);
   };
   // Spring t has its upper end in range for t in [up_begin, up_end) and its lower end for t in

@@ -29,11 +29,15 @@
 #include "fast/aerodynamics.hpp"
 #include "fast/engine.hpp"
 #include "fast/springs.hpp"
+#include "fast_util.hpp"
 #include "scene/scene.hpp"
 #include "test_util.hpp"
 
 using clothlab::Index;
 using clothlab::Matrix3X;
+using test::engine_of;
+using test::identical;
+using test::run;
 
 namespace {
 
@@ -42,22 +46,7 @@ namespace {
 // tables. Its column springs form a run of 44 x 41 = 1804 springs.
 std::string cloth(const std::string& extra, const std::string& method = "symplectic-euler",
                   Index rows = 45, Index cols = 41) {
-  return "[cloth]\nrows = " + std::to_string(rows) + "\ncols = " + std::to_string(cols) +
-         R"(
-spacing = 0.02
-mass = 0.5
-pins = "top-corners"
-[springs]
-ks = 60
-kd = 0.02
-shear_ks = 40
-shear_kd = 0.01
-[bending]
-ks = 5
-kd = 0.002
-[damping]
-rate = 0.05
-[gravity]
+  return test::hanging_cloth(rows, cols) + R"(
 [aerodynamics]
 wind = [3, 0, 2]
 [drag]
@@ -73,31 +62,6 @@ method = ")" +
 dt = 0.0005
 duration = 1.0
 )" + extra;
-}
-
-// The scene stepped `steps` times with the given engine settings, after `edit` (if given) has
-// changed its world.
-clothlab::Scene run(const std::string& text, bool fast, int threads, int steps,
-                    const std::function<void(clothlab::World&)>& edit = {}) {
-  clothlab::Scene scene = clothlab::parse_scene(text, "fast-path.toml");
-  if (edit) edit(scene.world);
-  if (!fast) scene.world.backend.reset();
-  scene.world.threads = threads;
-  for (int s = 0; s < steps; ++s)
-    scene.world.step(scene.dt);
-  return scene;
-}
-
-// Bit for bit: == on doubles (no tolerance).
-bool identical(const Matrix3X& a, const Matrix3X& b) {
-  return a.cols() == b.cols() && (a.array() == b.array()).all();
-}
-
-// The world's fast engine (a scene installs one unless it says fast_path = false).
-clothlab::fast::FastEngine& engine_of(const clothlab::World& world) {
-  auto* engine = dynamic_cast<clothlab::fast::FastEngine*>(world.backend.get());
-  REQUIRE(engine != nullptr);
-  return *engine;
 }
 
 clothlab::SpringDampers* spring_effect(clothlab::World& world, const char* name) {

@@ -16,6 +16,7 @@
 #include "fast/engine.hpp"
 #include "fast/float_room.hpp"
 #include "fast/scalar_kernels.hpp"
+#include "fast_util.hpp"
 #include "scene/scene.hpp"
 
 using clothlab::Index;
@@ -33,23 +34,7 @@ bool all_floats(const Matrix3X& a) {
 // A hanging cloth with every force the float room covers. (Contacts: the lesson scenes below.)
 std::string cloth(const std::string& method = "symplectic-euler", double dt = 0.0005,
                   const std::string& extra = "", const std::string& precision = "float") {
-  return R"([cloth]
-rows = 30
-cols = 27
-spacing = 0.02
-mass = 0.5
-pins = "top-corners"
-[springs]
-ks = 60
-kd = 0.02
-shear_ks = 40
-shear_kd = 0.01
-[bending]
-ks = 5
-kd = 0.002
-[damping]
-rate = 0.05
-[gravity]
+  return test::hanging_cloth(30, 27) + R"(
 [integrator]
 method = ")" +
          method + "\"\ndt = " + std::to_string(dt) + "\nduration = 1.0\n" + extra +

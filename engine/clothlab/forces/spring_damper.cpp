@@ -76,11 +76,21 @@ void SpringSet::set_kd(size_t k, double value) {
   changed();
 }
 
-void SpringSet::changed() {
-  // One counter for every set: two sets never share a version unless one is a copy of the other
-  // (and then their ends and constants are the same too).
+namespace {
+// One counter for every set and both versions: two sets never share a version unless one is a
+// copy of the other (and then their ends and constants, or their rest lengths, are the same too).
+unsigned long next_change() {
   static std::atomic<unsigned long> changes{0};
-  version_ = ++changes;
+  return ++changes;
+}
+}  // namespace
+
+void SpringSet::changed() {
+  version_ = next_change();
+}
+
+void SpringSet::rest_changed() {
+  rest_version_ = next_change();
 }
 
 void add_spring_family(SpringSet& springs, const std::vector<std::pair<Index, Index>>& pairs,

@@ -14,6 +14,8 @@
 #pragma once
 
 #include <algorithm>
+#include <cstdint>
+#include <cstring>
 #include <string>
 #include <utility>
 #include <vector>
@@ -49,6 +51,16 @@ Vec3 spring_damper_force(const Vec3& r1, const Vec3& r2, const Vec3& v1, const V
 // Exercise ex02.2: the energy [J] stored in the spring (not the damper), 1/2 ks (l - l0)^2.
 double spring_energy(const Vec3& r1, const Vec3& r2, double ks, double l0);
 
+// The same double, bit for bit: -0.0 and 0.0 differ here, which == would not see, and two NaNs
+// with the same bits are the same. (memcpy rather than std::bit_cast, which the C++ library of
+// the WebAssembly build lacks.)
+inline bool same_bits(double a, double b) {
+  std::uint64_t bits_a, bits_b;
+  std::memcpy(&bits_a, &a, sizeof a);
+  std::memcpy(&bits_b, &b, sizeof b);
+  return bits_a == bits_b;
+}
+
 // A family of springs as parallel arrays: spring k joins particles i(k) and j(k), with spring
 // constant ks(k) [N/m], damping factor kd(k) [N s/m], rest length l0(k) [m] and its rest length
 // as built, l_built(k) [m] (plasticity, lesson 06, keeps l0 within limits of l_built).
@@ -57,8 +69,11 @@ double spring_energy(const Vec3& r1, const Vec3& r2, double ks, double l0);
 // The fast engine (engine/fast/) keeps a description of the ends and the constants, and every
 // method that changes one of them moves version() to a number no other change, of any set, has
 // had: the fast engine compares it before every use, in every build, so it never computes with a
-// description of springs that are no longer there. The rest lengths change freely (plasticity
-// changes them every step): no description holds them.
+// description of springs that are no longer there. The rest lengths are no part of version()
+// (plasticity changes them every step, and what is built on the ends and constants, a solver's
+// factor, need not be built again), but a rest length set to other bits moves rest_version(),
+// the same way: the fast engine's grid stencils hold the rest lengths of springs at the length
+// they were built with.
 class SpringSet {
  public:
   size_t size() const { return i_.size(); }
@@ -90,17 +105,25 @@ class SpringSet {
   void reverse();
   void set_ks(size_t k, double value);
   void set_kd(size_t k, double value);
-  void set_l0(size_t k, double value) { l0_[k] = value; }
+  void set_l0(size_t k, double value) {
+    if (same_bits(l0_[k], value)) return;  // plasticity's elastic springs: no change
+    l0_[k] = value;
+    rest_changed();
+  }
 
   // Which change of the ends or the constants this set is at (see above).
   unsigned long version() const { return version_; }
+  // Which change of a rest length by set_l0 it is at (see above).
+  unsigned long rest_version() const { return rest_version_; }
 
  private:
   void changed();
+  void rest_changed();
 
   std::vector<Index> i_, j_;
   std::vector<double> ks_, kd_, l0_, l_built_;
   unsigned long version_ = 0;
+  unsigned long rest_version_ = 0;
 };
 
 // The spring effect of `world` called `name` ("springs" or "bending"), or nullptr.
