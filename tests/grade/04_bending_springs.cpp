@@ -131,11 +131,21 @@ TEST_SUITE("ex04") {
             POINTS(1)) {
     // Particle i sits at row i / cols, column i % cols, and must be in the grid: 0 <= i < n.
     // A bending pair lies on one row with columns 2 apart, or on one column with rows 2 apart.
-    // Non-square grids catch a column step of 2 * rows instead of 2 * cols.
-    const std::array<GridSize, 4> sizes = {{{4, 5}, {6, 3}, {3, 7}, {5, 2}}};
+    // Non-square grids catch a column step of 2 * rows instead of 2 * cols. The 3 x 4 grid comes
+    // first: its list tells apart the slips that mix rows and columns up (slips.hpp,
+    // kBendingPairs3x4), and a report names the one an answer is.
+    const std::array<GridSize, 5> sizes = {{{3, 4}, {4, 5}, {6, 3}, {3, 7}, {5, 2}}};
     for (const GridSize& g : sizes) {
       const std::vector<IndexPair> got = clothlab::bending_pairs(g.rows, g.cols);
       INFO("a " << g.rows << " x " << g.cols << " grid");
+      // What a check below says when it fails: on the 3 x 4 grid, the slip the answer is named
+      // first (the grader's one-line hint of a case is its first failure's message).
+      const bool three_by_four = g.rows == 3 && g.cols == 4;
+      auto named = [&](const std::string& general) {
+        return three_by_four
+                   ? grading::hint(canonical(got), grading::slips::kBendingPairs3x4, 0.0, general)
+                   : general;
+      };
       const Index n = g.rows * g.cols;
       std::vector<IndexPair> outside, not_two_apart;  // the offending pairs, as given
       for (const IndexPair& p : got) {
@@ -152,7 +162,7 @@ TEST_SUITE("ex04") {
         INFO(
             "indices must be grid-local, r * cols + c, between 0 and rows * cols - 1 (do not "
             "add the cloth's first particle: the engine does that)");
-        CHECK_MESSAGE(outside.empty(), "outside the grid: " << show(outside));
+        CHECK_MESSAGE(outside.empty(), named("outside the grid: " + show(outside)));
       }
       {
         INFO(
@@ -160,10 +170,10 @@ TEST_SUITE("ex04") {
             "(index + 2, never wrapping into the next row), or same column and rows r and "
             "r + 2 (index + 2 * cols)");
         CHECK_MESSAGE(not_two_apart.empty(),
-                      "not two apart on a row or a column: " << show(not_two_apart));
+                      named("not two apart on a row or a column: " + show(not_two_apart)));
       }
       {
-        // And there are rows (cols - 2) + cols (rows - 2) of them: 22, 18, 22 and 6 pairs.
+        // And there are rows (cols - 2) + cols (rows - 2) of them: 10, 22, 18, 22 and 6 pairs.
         const size_t count = static_cast<size_t>(g.rows * (g.cols - 2) + g.cols * (g.rows - 2));
         INFO("a " << g.rows << " x " << g.cols << " grid has " << count << " bending pairs; got "
                   << got.size());

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <initializer_list>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "clothlab/core/types.hpp"
@@ -14,14 +15,16 @@ namespace grading {
 
 // A wrong answer and what it means: the value the slip gives for the case's inputs, and the slip
 // in words. Most kernels return a Vec3; a case whose answer is a number, a count or a list of
-// positions lists SlipOf<double>, SlipOf<int> or SlipOf<std::vector<std::size_t>> instead, and the
-// same hint picks among them.
+// positions lists SlipOf<double>, SlipOf<int> or SlipOf<std::vector<std::size_t>> instead, one
+// whose answer is a list of index pairs SlipOf<IndexPairs> (given, as the answer is, with each pair
+// as (smaller, larger) and the list sorted), and the same hint picks among them.
 template <typename T>
 struct SlipOf {
   T value;
   const char* words;
 };
 using Slip = SlipOf<clothlab::Vec3>;
+using IndexPairs = std::vector<std::pair<clothlab::Index, clothlab::Index>>;
 
 // Whether an answer is a slip's value: each component within tol, or the same count.
 inline bool same_answer(const clothlab::Vec3& a, const clothlab::Vec3& b, double tol) {
@@ -35,6 +38,9 @@ inline bool same_answer(int a, int b, double /*tol*/) {
 }
 inline bool same_answer(const std::vector<std::size_t>& a, const std::vector<std::size_t>& b,
                         double /*tol*/) {
+  return a == b;
+}
+inline bool same_answer(const IndexPairs& a, const IndexPairs& b, double /*tol*/) {
   return a == b;
 }
 
@@ -64,6 +70,25 @@ inline const std::initializer_list<Slip> kGravity = {
 inline constexpr const char* kGravityHint =
     "gravity_force(m, g) must return the force m g; for m = 2 kg and g = (0, -9.8, 0) that is "
     "(0, -19.6, 0) N";
+
+// ex01.2, body 1 at r1, body 2 at r1 + d with d = (2, -3, 6), r = |d| = 7, G = 2, m1 = 3, m2 = 5:
+// G m1 m2 = 30, and F = (30 / r^2) (d / r) = (30 / 343) d. G m1 m2 / r^2 times d itself (d is r
+// long, not a unit vector): (30 / 49) d, seven times too strong; the unit vector d / r over r^3:
+// (30 / 2401) d; r taken as |d|^2 = 49 (squaredNorm for norm), 30 / 49^3 d = (30 / 117649) d; G
+// left out, (15 / 343) d; a flipped sign, -(30 / 343) d.
+inline const std::initializer_list<Slip> kGravitationNear = {
+    {(30.0 / 49.0) * Vec3(2.0, -3.0, 6.0),
+     "G m1 m2 / r^2 times d = r2 - r1, which is r long (a force that falls as 1 / r: divide d by "
+     "r^3, or use the unit vector d / r)"},
+    {(30.0 / 2401.0) * Vec3(2.0, -3.0, 6.0),
+     "G m1 m2 / r^3 times the unit vector d / r (r^3 goes with d itself, r^2 with d / r)"},
+    {(30.0 / 117649.0) * Vec3(2.0, -3.0, 6.0),
+     "r taken as |d|^2 (squaredNorm() where norm() belongs)"},
+    {(15.0 / 343.0) * Vec3(2.0, -3.0, 6.0), "G left out (F = G m1 m2 / r^2)"},
+    {-(30.0 / 343.0) * Vec3(2.0, -3.0, 6.0),
+     "a flipped sign (the pull on body 1 points toward body 2, along d = r2 - r1)"}};
+inline constexpr const char* kInverseSquare =
+    "F = G m1 m2 / r^2 along (r2 - r1) / r: check you divide by r^2 (or |d|^3 times d)";
 
 // ex01.3 and ex01.4, one step from v = (4, 5, 6) with f = (2, 0, -4), 1/m = 0.5, dt = 0.1:
 // a = (1, 0, -2), v' = v + a dt = (4.1, 5, 5.8). Without dt v + a = (5, 5, 4); without the mass
@@ -156,6 +181,44 @@ inline const std::initializer_list<SlipOf<int>> kBendingCount4x5 = {
     {31, "pairs one apart (those are the structural springs)"},
     {13, "loops that stop one short (c + 2 < cols allows the last pair)"},
     {28, "row pairs that wrap into the next row (test c + 2 < cols, not i + 2 < rows cols)"}};
+
+// ex04.1, the bending pairs of a 3 x 4 grid (3 rows of 4), particle (r, c) numbered r * 4 + c:
+//    0  1  2  3
+//    4  5  6  7
+//    8  9 10 11
+// Along the rows (c = 0, 1): 0-2 1-3 4-6 5-7 8-10 9-11; down the columns (r = 0): 0-8 1-9 2-10
+// 3-11: ten pairs. On a square grid each slip below gives the right answer; here each its own:
+//  - a column step of 2 * rows = 6: 0-6 1-7 2-8 3-9 down the columns, the rows as they are;
+//  - numbered r * rows + c = 3 r + c: the rows 0-2 1-3, 3-5 4-6, 6-8 7-9, the columns from row 0
+//    as they are, 0-8 1-9 2-10 3-11;
+//  - rows for cols in both, numbered 3 r + c with a column step of 6: the rows as just above,
+//    the columns 0-6 1-7 2-8 3-9;
+//  - the bounds swapped (c + 2 < rows, r + 2 < cols): c = 0 alone along the rows, 0-2 4-6 8-10,
+//    and r = 0, 1 down the columns, 0-8 1-9 2-10 3-11 and 4-12 5-13 6-14 7-15, outside the grid;
+//  - the grid read the other way round, 4 rows of 3 (numbered r * 3 + c): the rows 0-2 3-5 6-8
+//    9-11, the columns 0-6 1-7 2-8 3-9 4-10 5-11.
+// Each list as an answer is compared: sorted, each pair (smaller, larger).
+inline const std::initializer_list<SlipOf<IndexPairs>> kBendingPairs3x4 = {
+    {{{0, 2}, {0, 6}, {1, 3}, {1, 7}, {2, 8}, {3, 9}, {4, 6}, {5, 7}, {8, 10}, {9, 11}},
+     "a column step of 2 * rows (two down a column is i + 2 * cols: a row holds cols particles)"},
+    {{{0, 2}, {0, 8}, {1, 3}, {1, 9}, {2, 10}, {3, 5}, {3, 11}, {4, 6}, {6, 8}, {7, 9}},
+     "particle (r, c) numbered r * rows + c (it is r * cols + c: a row holds cols particles)"},
+    {{{0, 2}, {0, 6}, {1, 3}, {1, 7}, {2, 8}, {3, 5}, {3, 9}, {4, 6}, {6, 8}, {7, 9}},
+     "rows where cols belongs, in the numbering r * rows + c and the column step 2 * rows"},
+    {{{0, 2},
+      {0, 8},
+      {1, 9},
+      {2, 10},
+      {3, 11},
+      {4, 6},
+      {4, 12},
+      {5, 13},
+      {6, 14},
+      {7, 15},
+      {8, 10}},
+     "the bounds swapped (along a row c + 2 < cols, down a column r + 2 < rows)"},
+    {{{0, 2}, {0, 6}, {1, 7}, {2, 8}, {3, 5}, {3, 9}, {4, 10}, {5, 11}, {6, 8}, {9, 11}},
+     "rows and cols swapped throughout: the grid read as cols rows of rows particles"}};
 
 // ex05.1, falling at (0, -4, 0) onto y = 0 with e = 0.5, no friction: v' = (0, 2, 0). v_n kept
 // with its sign, e v_n: (0, -2, 0); e left out, -v_n: (0, 4, 0); no bounce at all: (0, -4, 0).

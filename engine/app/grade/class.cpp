@@ -693,6 +693,7 @@ struct Compared {
   fs::path file;
   std::vector<std::pair<std::string, int>> origin;  // exercise file, line (from 1)
   std::vector<std::string> original;                // the lines as the student wrote them
+  std::vector<bool> own;  // whether the line is the student's own: not blank, not the stub's
 };
 
 struct Region {
@@ -758,6 +759,7 @@ Similarity compare(const std::vector<Student>& students, const fs::path& work) {
       for (std::size_t k = 0; k < mine.size(); ++k) {
         c.origin.emplace_back(x.name, static_cast<int>(k + 1));
         c.original.push_back(mine[k]);
+        c.own.push_back(!trimmed(own[k]).empty());
         text += own[k] + "\n";
       }
     }
@@ -834,12 +836,25 @@ Similarity compare(const std::vector<Student>& students, const fs::path& work) {
 }
 
 // Lines first..last of a compared file, as the student wrote them, each with its file and line.
+// A run of two or more lines that are not the student's own (shared with the shipped stub, or
+// blank) is folded into one line that counts them: the comparison left them out, and a region
+// that spans two exercises would otherwise show the whole file between them.
 std::string region_text(const Compared& c, int first, int last) {
   std::string s;
-  for (int k = std::max(first, 1); k <= last && k <= static_cast<int>(c.original.size()); ++k) {
+  const int end = std::min(last, static_cast<int>(c.original.size()));
+  for (int k = std::max(first, 1); k <= end;) {
+    int run = 0;  // the lines from k on that are not the student's own
+    while (k + run <= end && !c.own[static_cast<std::size_t>(k + run - 1)])
+      ++run;
+    if (run >= 2) {
+      s += fmt::format("        ... {} lines as in the shipped stub, or blank\n", run);
+      k += run;
+      continue;
+    }
     const auto& [file, line] = c.origin[static_cast<std::size_t>(k - 1)];
     s += fmt::format("{}:{:<4} {}\n", file.substr(0, 2), line,
                      c.original[static_cast<std::size_t>(k - 1)]);
+    ++k;
   }
   return s;
 }
@@ -864,16 +879,62 @@ std::string hints_html(const Failing& f) {
   return h;
 }
 
+// The start of a report page, with the style the class's pages share.
+std::string page_head(const std::string& title) {
+  return "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\"><title>" + html(title) +
+         "</title>\n<style>body{font-family:sans-serif;margin:2em;max-width:110em}"
+         "table{border-collapse:collapse}td,th{border:1px solid #ccc;padding:2px 6px;"
+         "text-align:right;vertical-align:top}td.l,th.l{text-align:left}pre{margin:0;"
+         "font-size:85%;white-space:pre-wrap}.bad{color:#a00}.side td{text-align:left}"
+         "</style></head><body>\n";
+}
+
+// The tokens of a pair's matching regions, summed.
+int tokens_of(const Pair& p) {
+  int tokens = 0;
+  for (const Region& r : p.regions)
+    tokens += r.tokens;
+  return tokens;
+}
+
+// The page of the pair ranked `rank` (from 0) in the similarity report, in REPORT_DIR/pairs/:
+// its name is the rank alone, never a student's name.
+std::string pair_file(std::size_t rank) {
+  return fmt::format("pair-{:02}.html", rank + 1);
+}
+
+// A pair's matching regions side by side, each line as the student wrote it. They are a page of
+// their own, linked from the class's page: a region can run to a whole file, and thirty of them
+// side by side made the class's page megabytes long.
+std::string pair_page(const Similarity& sim, const std::vector<Student>& students,
+                      std::size_t rank) {
+  const Pair& p = sim.pairs[rank];
+  const Compared& a = sim.compared[p.a];
+  const Compared& b = sim.compared[p.b];
+  const std::string name_a = one_line(students[a.student].name);
+  const std::string name_b = one_line(students[b.student].name);
+  std::string h = page_head("clothlab: similar code, " + name_a + " and " + name_b);
+  h += fmt::format(
+      "<p><a href=\"../index.html#similar\">&larr; the class</a></p>\n<h1>{} % / {} %: {} and "
+      "{}</h1>\n<p>Pair {} of the class's ranking: {} % of the first student's code is found in "
+      "the second's, and {} % the other way. sim_c++ matched {} regions ({} tokens), shown as the "
+      "two wrote them, each line with its file (the lesson's number) and line. Runs of lines as "
+      "in the shipped stub are folded: the comparison left them out.</p>\n<table "
+      "class=\"side\"><tr><th class=\"l\">{}</th><th class=\"l\">{}</th></tr>\n",
+      p.a_in_b, p.b_in_a, html(name_a), html(name_b), rank + 1, p.a_in_b, p.b_in_a,
+      p.regions.size(), tokens_of(p), html(name_a), html(name_b));
+  for (const Region& r : p.regions) {
+    h += fmt::format("<tr><td><pre>{}</pre></td><td><pre>{}</pre></td></tr>\n",
+                     html(region_text(a, r.a_first, r.a_last)),
+                     html(region_text(b, r.b_first, r.b_last)));
+  }
+  return h + "</table>\n</body></html>\n";
+}
+
 std::string page(const std::vector<Student>& students, const std::vector<Wrong>& wrong,
                  const Similarity& sim, const std::string& summary) {
-  std::string h =
-      "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\"><title>clothlab: the "
-      "class</title>\n<style>body{font-family:sans-serif;margin:2em;max-width:110em}"
-      "table{border-collapse:collapse}td,th{border:1px solid #ccc;padding:2px 6px;"
-      "text-align:right;vertical-align:top}td.l,th.l{text-align:left}pre{margin:0;"
-      "font-size:85%;white-space:pre-wrap}.bad{color:#a00}.side td{text-align:left}"
-      "</style></head><body>\n<h1>The class</h1>\n<pre>" +
-      html(summary) + "</pre>\n<h2>Grades</h2>\n<table><tr><th class=\"l\">student</th>";
+  std::string h = page_head("clothlab: the class") + "<h1>The class</h1>\n<pre>" + html(summary) +
+                  "</pre>\n<h2>Grades</h2>\n<table><tr><th class=\"l\">student</th>";
   const auto columns = exercise_columns(students);
   int max = 0;
   for (const auto& [id, points] : columns) {
@@ -918,7 +979,7 @@ std::string page(const std::vector<Student>& students, const std::vector<Wrong>&
     }
     h += "</table>\n";
   }
-  h += "<h2>Similar code</h2>\n";
+  h += "<h2 id=\"similar\">Similar code</h2>\n";
   if (!sim.missing.empty()) {
     h += "<p class=\"bad\">" + html(sim.missing) + "</p>\n";
   } else {
@@ -927,21 +988,26 @@ std::string page(const std::vector<Student>& students, const std::vector<Wrong>&
         "students' own lines: the lines each shares with the shipped stub are left out. "
         "&ldquo;A in B&rdquo; is the share of A's code also found in B. Code close to the "
         "reference solution is similar in every student who wrote it: read the regions "
-        "before you conclude.</p>\n",
-        sim.compared.size());
-    for (const Pair& p : sim.pairs) {
-      const Compared& a = sim.compared[p.a];
-      const Compared& b = sim.compared[p.b];
-      h += fmt::format("<h3>{} % / {} %: {} and {}</h3>\n<table class=\"side\">", p.a_in_b,
-                       p.b_in_a, html(one_line(students[a.student].name)),
-                       html(one_line(students[b.student].name)));
-      for (const Region& r : p.regions) {
-        h += fmt::format("<tr><td><pre>{}</pre></td><td><pre>{}</pre></td></tr>\n",
-                         html(region_text(a, r.a_first, r.a_last)),
-                         html(region_text(b, r.b_first, r.b_last)));
-      }
-      h += "</table>\n";
+        "before you conclude: each pair's link opens them side by side. {} pairs of 10 % or "
+        "more{}.</p>\n",
+        sim.compared.size(), sim.pairs_found,
+        sim.pairs_found > sim.pairs.size() ? fmt::format(", the first {} shown", sim.pairs.size())
+                                           : std::string());
+    if (!sim.pairs.empty()) {
+      h += "<table><tr><th>pair</th><th>A in B</th><th>B in A</th><th class=\"l\">A</th><th "
+           "class=\"l\">B</th><th>regions</th><th>tokens</th><th class=\"l\"></th></tr>\n";
     }
+    for (std::size_t k = 0; k < sim.pairs.size(); ++k) {
+      const Pair& p = sim.pairs[k];
+      h += fmt::format(
+          "<tr><td>{}</td><td>{} %</td><td>{} %</td><td class=\"l\">{}</td><td "
+          "class=\"l\">{}</td><td>{}</td><td>{}</td><td class=\"l\"><a href=\"pairs/{}\">side by "
+          "side</a></td></tr>\n",
+          k + 1, p.a_in_b, p.b_in_a, html(one_line(students[sim.compared[p.a].student].name)),
+          html(one_line(students[sim.compared[p.b].student].name)), p.regions.size(), tokens_of(p),
+          pair_file(k));
+    }
+    if (!sim.pairs.empty()) h += "</table>\n";
   }
   return h + "</body></html>\n";
 }
@@ -1052,11 +1118,19 @@ void grade_class(const ClassOptions& given) {
   write_file((out / "class.csv").string(), class_csv(students, o.dir));
   write_file((out / "what-went-wrong.txt").string(), wrong_text(wrong));
   write_file((out / "similarity.txt").string(), similarity_text(sim, students));
+  // The pairs' pages of this run alone: those of a run before it would name other pairs.
+  const fs::path pairs_dir = out / "pairs";
+  fs::remove_all(pairs_dir, ec);
+  if (!sim.pairs.empty()) {
+    fs::create_directories(pairs_dir, ec);
+    for (std::size_t k = 0; k < sim.pairs.size(); ++k)
+      write_file((pairs_dir / pair_file(k)).string(), pair_page(sim, students, k));
+  }
   write_file((out / "index.html").string(), page(students, wrong, sim, summary));
   fmt::print("\n{}", summary);
   if (!sim.missing.empty()) fmt::print("{}\n", sim.missing);
   fmt::print(
-      "wrote {}/: index.html, class.csv, what-went-wrong.txt, similarity.txt, "
+      "wrote {}/: index.html, pairs/*.html, class.csv, what-went-wrong.txt, similarity.txt, "
       "submissions/*.json\n",
       one_line(out.string()));
 }

@@ -2,15 +2,15 @@
 """check_class.py CLOTHLAB SOURCE WORK_DIR: `clothlab grade --class` on two small classes.
 
 A folder per student: a solution of lesson 02, a copy of it (the similarity report must pair the
-two), a planted mistake (what-went-wrong must name its failing case and hint), a file that does not
-compile, and students whose folder names are hostile (quotes and a `$(...)`, a line break and a
-fake total, HTML, a leading dash, 200 characters) and who hand in the shipped stub unchanged (the
-stub is left out of the comparison, so no two of them are paired). Then the class again (nothing is
-graded again), one file changed (that submission alone is graded again), the class without sim_c++
-(graded all the same, and the report says how to get it), the class interrupted once a changed
-submission is graded (the rest is graded by the next run), and Gradescope's export layout, whose
-metadata names a student "../../escape". Lesson 02 alone is graded: 26 to 45 s on two shared
-cores.
+two, their matching regions on a page of the pair's own that index.html links), a planted mistake
+(what-went-wrong must name its failing case and hint), a file that does not compile, and students
+whose folder names are hostile (quotes and a `$(...)`, a line break and a fake total, HTML, a
+leading dash, 200 characters) and who hand in the shipped stub unchanged (the stub is left out of
+the comparison, so no two of them are paired). Then the class again (nothing is graded again), one
+file changed (that submission alone is graded again), the class without sim_c++ (graded all the
+same, and the report says how to get it), the class interrupted once a changed submission is graded
+(the rest is graded by the next run), and Gradescope's export layout, whose metadata names a student
+"../../escape". Lesson 02 alone is graded: 26 to 45 s on two shared cores.
 """
 import csv
 import json
@@ -130,10 +130,31 @@ if not any(re.search(r"(9\d|100) % of alice(-copy)? is in alice(-copy)?;", l) fo
     problem("similarity.txt does not pair alice and her copy at 90 % or more")
 if any("script" in l or "xxxx" in l or "quote" in l for l in pairs):
     problem("students who handed in the shipped stub are paired: the stub was compared")
-if not re.search(r'<table class="side"><tr><td><pre>02:\d+ +\S', page):
-    problem("index.html does not show the matching regions side by side")
 if "ex02.2" not in page or "alice" not in page.split("Similar code")[1]:
     problem("index.html lacks what went wrong or the similar pair")
+# The matching regions are on a page of each pair's own (pairs/pair-NN.html), linked from its row
+# of index.html: side by side, each line as written with its file and line, the lines the students
+# share with the shipped stub folded. On index.html itself they made the page of a class of 50
+# megabytes long, so it holds none of the students' code.
+if 'class="side"' in page or "f_sd" in page:
+    problem("index.html holds matching regions itself: they belong on each pair's page")
+rows_linked = re.findall(r'<tr><td>(\d+)</td>.*?<a href="pairs/(pair-\d\d\.html)">', page)
+if not rows_linked or [int(n) for n, _ in rows_linked] != list(range(1, len(rows_linked) + 1)):
+    problem(f"index.html's similar pairs are not ranked rows linking their pages: {rows_linked}")
+alice_row = [l for l in page.splitlines() if re.search(r">alice(-copy)?</td><td class=\"l\">alice(-copy)?<", l)]
+link = re.search(r'href="pairs/(pair-\d\d\.html)"', alice_row[0]) if alice_row else None
+pair_page = os.path.join(out, "pairs", link.group(1)) if link else ""
+if not os.path.isfile(pair_page):
+    problem(f"the pair alice and alice-copy has no page of its own: {alice_row}")
+else:
+    side = open(pair_page).read()
+    if not re.search(r'<tr><td><pre>02:\d+ +\S', side) or "const double f_sd = -ks * (l0 - l)" not in side:
+        problem(f"{pair_page} does not show alice's lines side by side with their places")
+    if "Exercise ex02.2: the energy" in side or "lines as in the shipped stub" not in side:
+        problem(f"{pair_page} shows the lines of the shipped stub between the exercises unfolded")
+pairs_dir = os.path.join(out, "pairs")
+if sorted(os.listdir(pairs_dir) if os.path.isdir(pairs_dir) else []) != sorted(l for _, l in rows_linked):
+    problem("pairs/ holds other pages than those index.html links")
 
 # Again: nothing to grade. Then bob mends his file: he alone is graded again.
 said = grade(klass, out)
@@ -181,6 +202,8 @@ for d in os.environ.get("PATH", "/usr/bin:/bin").split(":"):
 said = grade(klass, out, dict(os.environ, PATH=bin_dir))
 if "apt-get install similarity-tester" not in open(os.path.join(out, "similarity.txt")).read():
     problem("without sim_c++, similarity.txt does not say how to get it")
+if os.path.exists(pairs_dir):
+    problem("without sim_c++, the pairs' pages of the run before are left in pairs/")
 if len(table(out)[1]) != len(students):
     problem("without sim_c++, the class table is not complete")
 

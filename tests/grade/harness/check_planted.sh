@@ -1,17 +1,20 @@
 #!/usr/bin/env bash
-# check_planted.sh CLOTHLAB SOURCE WORK_DIR PLANTS: grades submissions made from copies of
-# solutions/ with planted mistakes, and checks that each scores what PLANTS says it must. PLANTS
-# (tests/grade/harness/planted/*.txt) holds blocks of two kinds:
+# check_planted.sh CLOTHLAB SOURCE WORK_DIR PLANTS [--parse-only]: grades submissions made from
+# copies of solutions/ with planted mistakes, and checks that each scores what PLANTS says it must.
+# PLANTS (tests/grade/harness/planted/*.txt) holds blocks of two kinds:
 #
 #   mutant exNN.k FILE: what the mistake is
 #   - one line of solutions/FILE, as it is (leading spaces aside; it must occur exactly once)
 #   + the line that replaces it
-#   ? an extended regular expression that a line of the grader's output must match (optional,
-#     any number: the hint a lesson promises for this mistake, say)
+#   ? an extended regular expression that a line of the grader's output must match (any number:
+#     the hint that names this mistake, say)
+#   ! no hint check: why this mistake has no "?" line
 #
 # a copy of solutions/FILE with that one line changed, graded on exercise exNN.k alone: it must
 # compile and lose points there (a grading case that still gives full marks cannot tell the
-# mistake from the right answer);
+# mistake from the right answer), and its report must match each "?" line. A mutant needs at least
+# one "?" line, or a "!" line that says why it has none: a planted mistake whose report is never
+# read could lose its hint unnoticed. Such a PLANTS file is refused before anything is graded.
 #
 #   submission NAME: what its kernels do
 #   region FILE exNN.k
@@ -22,10 +25,19 @@
 # lists two bodies, in order) and kNaN defined as a quiet NaN, graded on every exercise, hidden
 # cases included: it must compile and score 0 overall (a kernel that computes nothing earns
 # nothing).
+#
+# --parse-only reads PLANTS and checks what it says (each planted line found, each mutant's hint
+# check) without grading anything: CLOTHLAB is not run.
 set -euo pipefail
 source "$(dirname "$0")/submission_checks.sh"
 source "$(dirname "$0")/plant.sh"
 plants=$4
+parse_only=false
+case ${5:-} in
+  "") ;;
+  --parse-only) parse_only=true ;;
+  *) echo "check_planted: unknown option \"$5\" (expected --parse-only)" >&2; exit 2 ;;
+esac
 
 # The results' total score, their maximum, and the cases that scored, from results.json (read
 # with CMake's JSON parser, which the build has anyway).
@@ -95,12 +107,17 @@ plant_regions() {
 # --- read PLANTS into folders to grade ---------------------------------------------------------
 mutants=()     # name|exercise|what
 declare -A expect_lines  # name -> the "?" patterns, one a line
+declare -A no_hint       # name -> why it has no "?" line
+declare -A mutant_at     # name -> the line of PLANTS that starts it
 submissions=() # names
 kind="" name="" file="" old=""
+number=0
 while IFS= read -r line || [[ -n $line ]]; do
+  number=$((number + 1))
   if [[ $line =~ ^mutant\ (ex[0-9][0-9]\.[0-9]+)\ ([0-9][0-9]_[a-z_]+\.cpp):\ (.*)$ ]]; then
     kind=mutant
     name="mutant-$((${#mutants[@]} + 1))"
+    mutant_at[$name]=$number
     file=${BASH_REMATCH[2]}
     mutants+=("$name|${BASH_REMATCH[1]}|${BASH_REMATCH[3]}")
     mkdir -p "$work/$name"
@@ -111,6 +128,8 @@ while IFS= read -r line || [[ -n $line ]]; do
     plant_line "$work/$name/$file" "$old" "${BASH_REMATCH[1]}" || true
   elif [[ $kind == mutant && $line =~ ^\?\ (.*)$ ]]; then
     expect_lines[$name]+="${BASH_REMATCH[1]}"$'\n'
+  elif [[ $kind == mutant && $line =~ ^!\ no\ hint\ check:\ *(.*)$ ]]; then
+    no_hint[$name]=${BASH_REMATCH[1]}
   elif [[ $line =~ ^submission\ ([a-z0-9-]+):\ (.*)$ ]]; then
     kind=submission
     name=${BASH_REMATCH[1]}
@@ -130,7 +149,7 @@ while IFS= read -r line || [[ -n $line ]]; do
   elif [[ -z $line || $line == \#* ]]; then
     continue
   else
-    echo "check_planted: $plants: cannot read the line \"$line\"" >&2
+    echo "check_planted: $plants:$number: cannot read the line \"$line\"" >&2
     exit 2
   fi
 done <"$plants"
@@ -154,6 +173,32 @@ for entry in "${submissions[@]}"; do
   done
   rm -rf "$work/$name/bodies"
 done
+
+# Every mutant reads its report: a "?" line, or a "!" line that says why not (and not both).
+for entry in "${mutants[@]}"; do
+  IFS='|' read -r name exercise what <<<"$entry"
+  at="$(basename "$plants"):${mutant_at[$name]}: mutant $exercise ($what)"
+  if [[ -v no_hint[$name] ]]; then
+    if [[ -z ${no_hint[$name]// /} ]]; then
+      problem "$at: its \"! no hint check:\" line gives no reason"
+    elif [[ -n ${expect_lines[$name]:-} ]]; then
+      problem "$at: has \"?\" lines and a \"! no hint check:\" line; keep one"
+    fi
+  elif [[ -z ${expect_lines[$name]:-} ]]; then
+    problem "$at: no \"?\" line checks the grader's hint for this mistake; add one (what" \
+      "the report must say of it), or a line \"! no hint check: WHY\""
+  fi
+done
+if [[ ${#problems[@]} -gt 0 ]]; then
+  echo "check_planted: $plants, nothing graded:" >&2
+  printf '  %s\n' "${problems[@]}" >&2
+  exit 1
+fi
+if $parse_only; then
+  echo "check_planted: $(basename "$plants") reads well: ${#mutants[@]} mutants, each with its" \
+    "hint check or the reason it has none, and ${#submissions[@]} submissions"
+  exit 0
+fi
 
 # --- grade them --------------------------------------------------------------------------------
 for entry in "${mutants[@]}"; do
