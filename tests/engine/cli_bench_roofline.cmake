@@ -1,7 +1,9 @@
 # `clothlab bench roofline --quick --csv F`: the machine's limits are printed as positive figures;
 # the CSV has the documented header and a row per cloth size whose numbers are positive and
 # finite; each floor is the larger of its compute and bandwidth floors; and the engine's step is
-# no faster than its floor.
+# no faster than its floor. The threads' part is there: the copy on 2 threads, a row per size of
+# the 1 and 2 thread steps with what two threads lose and to what, and of the model of 8 and 16
+# cores, which says its socket bandwidth is assumed. No timing is asserted by value.
 #
 # Why the engine cannot beat the floor: every spring of a step takes a square root and then a
 # division (the reference kernel), and the compute floor is what those two cost per spring at the
