@@ -260,14 +260,13 @@ int run_python(const fs::path& script, const fs::path& csv, const fs::path& out)
 
 }  // namespace
 
-double wake_ns(int threads, int meetings) {
+double wake_ns(int threads, int meetings, int wakes) {
   using Clock = std::chrono::steady_clock;
   ThreadTeam team(threads);
-  constexpr int kWakes = 20000;
   double best = HUGE_VAL;
   for (int r = 0; r < 5; ++r) {
     const Clock::time_point start = Clock::now();
-    for (int w = 0; w < kWakes; ++w) {
+    for (int w = 0; w < wakes; ++w) {
       team.run([&](int) {
         for (int m = 0; m < meetings; ++m)
           team.sync();
@@ -275,7 +274,7 @@ double wake_ns(int threads, int meetings) {
     }
     best = std::min(best, std::chrono::duration<double>(Clock::now() - start).count());
   }
-  return 1e9 * best / kWakes;
+  return 1e9 * best / wakes;
 }
 
 void draw_plot(const fs::path& script, const fs::path& csv, const fs::path& plot) {

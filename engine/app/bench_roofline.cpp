@@ -565,7 +565,7 @@ int bench_roofline(RooflineOptions opt) {
   std::vector<ThreadsRow> threads;
   for (const Row& r : rows)
     threads.push_back(measure_threads(r.n, opt.repeats, opt.min_seconds));
-  const double wake_2 = 1e-9 * wake_ns(2, 1);
+  const double wake_2 = 1e-9 * wake_ns(2, 1, opt.quick ? 500 : 20000);
   fmt::print(
       "\n  threads: the same step on 1 and on 2 threads, taking turns, {} repeats of a multiple of "
       "32 steps (the guard's\n  energy check comes every 32), the repeat of median time; ns per "

@@ -19,6 +19,7 @@
 #include <vector>
 
 #include "clothlab/bodies/cloth.hpp"
+#include "clothlab/core/guard.hpp"
 #include "clothlab/core/threads.hpp"
 #include "clothlab/forces/aerodynamics.hpp"
 #include "clothlab/forces/bending.hpp"
@@ -873,6 +874,42 @@ TEST_CASE("fast path: an Euler step wakes the threads once, and so does a force 
       scene.world.compute_forces_readable(scene.world.particles.x, scene.world.particles.v,
                                           f_readable);
       CHECK(identical(f, f_readable));
+    }
+  }
+}
+
+TEST_CASE("fast path: a state spoiled between steps stops the one-job pass before anything moves") {
+  // Every thread copies and checks its particles, meets the others at the barrier, and stops
+  // there if any found a bad value: the guard then names the step about to be taken and the
+  // particle, and no particle has moved. The spoiled particle in the first range, the last, and
+  // (on 3 threads) the middle one.
+  const auto no_buoyancy = [](clothlab::World& w) {
+    std::erase_if(w.force_effects, [](const auto& e) { return e->name() == "buoyancy"; });
+  };
+  for (int threads : {1, 2, 3}) {
+    for (const Index bad : {Index{5}, Index{900}, Index{1840}}) {
+      CAPTURE(threads);
+      CAPTURE(bad);
+      clothlab::Scene scene = run(cloth(""), true, threads, 10, no_buoyancy);
+      clothlab::World& world = scene.world;
+      world.particles.x(1, bad) = std::numeric_limits<double>::infinity();
+      const Matrix3X x = world.particles.x, v = world.particles.v;
+      std::string what;
+      try {
+        world.step(scene.dt);
+      } catch (const clothlab::SimulationError& e) {
+        what = e.what();
+        CHECK(e.step() == 11);
+        CHECK(e.particle() == bad);
+      }
+      CHECK(what.find("blew up before step 11") != std::string::npos);
+      CHECK(identical(world.particles.x, x));
+      CHECK(identical(world.particles.v, v));
+      CHECK(world.steps == 10);
+      // Mended, the world steps on, the threads still there.
+      world.particles.x(1, bad) = 0.0;
+      world.step(scene.dt);
+      CHECK(world.steps == 11);
     }
   }
 }
