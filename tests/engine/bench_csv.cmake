@@ -4,7 +4,6 @@
 # has as many fields as HEADER, and its fields FIRST and after (counted from 0) are positive finite
 # numbers, except those whose indices follow OUT, which are finite numbers of either sign (a
 # difference of two measurements). OUT receives the rows, each a line of comma-separated fields.
-cmake_policy(SET CMP0057 NEW)  # if(... IN_LIST ...)
 function(bench_csv_rows file header first out)
   set(signed ${ARGN})
   file(STRINGS ${file} lines)
@@ -24,7 +23,8 @@ function(bench_csv_rows file header first out)
     endif()
     foreach(index RANGE ${first} ${last})
       list(GET fields ${index} value)
-      if(index IN_LIST signed)
+      list(FIND signed ${index} at)
+      if(NOT at EQUAL -1)
         if(NOT value MATCHES "^-?[0-9]+(\\.[0-9]+)?(e[-+][0-9]+)?$")
           message(FATAL_ERROR "row '${line}': field ${index} is '${value}'; expected a finite "
                               "number")
