@@ -30,6 +30,7 @@
 #include "analysis/accuracy.hpp"
 #include "app/build_info.hpp"
 #include "app/process.hpp"
+#include "clothlab/core/threads.hpp"
 #include "clothlab/core/world.hpp"
 #include "clothlab/forces/gravity.hpp"
 #include "clothlab/integrators/euler.hpp"
@@ -258,6 +259,23 @@ int run_python(const fs::path& script, const fs::path& csv, const fs::path& out)
 }
 
 }  // namespace
+
+double wake_ns(int threads, int meetings, int wakes) {
+  using Clock = std::chrono::steady_clock;
+  ThreadTeam team(threads);
+  double best = HUGE_VAL;
+  for (int r = 0; r < 5; ++r) {
+    const Clock::time_point start = Clock::now();
+    for (int w = 0; w < wakes; ++w) {
+      team.run([&](int) {
+        for (int m = 0; m < meetings; ++m)
+          team.sync();
+      });
+    }
+    best = std::min(best, std::chrono::duration<double>(Clock::now() - start).count());
+  }
+  return 1e9 * best / wakes;
+}
 
 void draw_plot(const fs::path& script, const fs::path& csv, const fs::path& plot) {
   const int status = run_python(script, csv, plot);

@@ -24,6 +24,11 @@ double reference_ns_per_spring_step(int n, int repeats, double min_seconds);
 // The option `--sizes N,N,...` of the commands that time bench speed's cloths.
 void add_cloth_sizes_option(CLI::App& command, std::vector<int>& sizes);
 
+// What one wake of `threads` threads costs with nothing to do [ns]: ThreadTeam::run of a job
+// that only meets `meetings` times at the barrier (ThreadTeam::sync), the fastest of 5 runs of
+// `wakes` (bench_methods.cpp, bench_roofline.cpp).
+double wake_ns(int threads, int meetings = 0, int wakes = 20000);
+
 // Runs `python3 script csv plot` (the plot scripts the bench commands write next to their CSV)
 // and, when the plot could not be drawn, warns how to get it.
 void draw_plot(const std::filesystem::path& script, const std::filesystem::path& csv,

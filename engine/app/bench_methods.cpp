@@ -496,21 +496,6 @@ double wakes_per_step(const std::string& text, int threads, int steps) {
   return static_cast<double>(world.thread_wakes() - before) / steps;
 }
 
-// What one wake of `threads` threads costs with nothing to do [ns]: ThreadTeam::run of an empty
-// job, the fastest of 5 runs of 20000.
-double wake_ns(int threads) {
-  ThreadTeam team(threads);
-  constexpr int kWakes = 20000;
-  double best = std::numeric_limits<double>::infinity();
-  for (int r = 0; r < 5; ++r) {
-    const Clock::time_point start = Clock::now();
-    for (int w = 0; w < kWakes; ++w)
-      team.run([](int) {});
-    best = std::min(best, std::chrono::duration<double>(Clock::now() - start).count());
-  }
-  return 1e9 * best / kWakes;
-}
-
 // One pass of a loop of square roots and divisions alone over `n` values (kept out of line, so
 // that the passes are not turned inside out into one chain per value).
 [[gnu::noinline]] void sqrt_div_pass(double* v, int n) {

@@ -20,6 +20,12 @@
 //   the engine  bench speed's `reference` row on 1 thread (its own code, run from here), and its
 //               ratio to the floor.
 //
+//   threads     the engine's step on 1 and 2 threads (bench speed's cloth, taking turns), what two
+//               threads lose of twice one's speed and to what (the step's serial part, the wake and
+//               the barrier, the imbalance of the two ranges, each thread's share taking longer
+//               than half the whole), and a model of the step on 8 and 16 cores from this run's
+//               figures and an assumed bandwidth of a server socket.
+//
 // Limits are the fastest of their repeats (a busy machine only slows a repeat: the fastest is the
 // nearest to what the machine can do), the engine the median of its repeats, as in bench speed.
 // engine/fast/SPEED.md ("The roofline") explains the model and what it leaves out.
@@ -35,11 +41,15 @@
 #include <string>
 #include <vector>
 
+#include <sys/resource.h>
+
 #include <fmt/format.h>
 #include <CLI/CLI.hpp>
 
 #include "app/bench.hpp"
 #include "app/build_info.hpp"
+#include "clothlab/core/threads.hpp"
+#include "clothlab/core/world.hpp"
 #include "clothlab/forces/gravity.hpp"
 #include "clothlab/forces/spring_damper.hpp"
 #include "fast/springs.hpp"
@@ -66,6 +76,7 @@ struct RooflineOptions {
   int repeats = 5;
   double min_seconds = 0.25;  // [s] one repeat of the engine's step; a hundredth for the limits
   double stream_mib = 0.0;    // [MiB] each array of the memory figures; 0: 4 x the last level
+  double socket_gbs = 100.0;  // [GB/s] the model's server socket: an assumption, not measured
   std::string csv;
   bool quick = false;
 };
@@ -206,6 +217,8 @@ struct Memory {
   double array_bytes = 0.0;  // of each array, for the figures past the last-level cache
   std::string why_size;
   double copy_gbs = 0.0, read_gbs = 0.0;  // [GB/s] past the last-level cache
+  double copy_gbs_2 = 0.0;                // [GB/s] the copy split over 2 threads
+  double socket_gbs = 0.0;  // [GB/s] the model's server socket (an assumption, --socket-gbs)
 };
 
 // A copy pass over `bytes` bytes in all (bytes / 2 read, bytes / 2 written) [GB/s], fastest of
@@ -215,6 +228,21 @@ double copy_gbs(Memory& m, double bytes, int repeats, double seconds) {
   const std::uint64_t zero = static_cast<std::uint64_t>(m.b.size() == 0);  // 0, unknown to GCC
   const double s =
       fastest_call(repeats, seconds, [&] { copy_words(m.a.data(), m.b.data(), words, zero); });
+  return 16.0 * static_cast<double>(words) / s * 1e-9;
+}
+
+// The same copy split over the threads of `team` (each copies its own contiguous part), 8 bytes
+// read and 8 written a word [GB/s], fastest of the repeats: the bandwidth the cores share.
+double copy_gbs_threads(Memory& m, ThreadTeam& team, double bytes, int repeats, double seconds) {
+  const long words = std::max(1L, std::lround(bytes / 16.0));
+  const std::uint64_t zero = static_cast<std::uint64_t>(m.b.size() == 0);
+  const long parts = team.size();
+  const double s = fastest_call(repeats, seconds, [&] {
+    team.run([&](int t) {
+      const long begin = words * t / parts, end = words * (t + 1) / parts;
+      copy_words(m.a.data() + begin, m.b.data() + begin, end - begin, zero);
+    });
+  });
   return 16.0 * static_cast<double>(words) / s * 1e-9;
 }
 
@@ -267,6 +295,153 @@ StepBytes step_bytes(const World& world) {
     }
   }
   return b;
+}
+
+// --- Threads -------------------------------------------------------------------------------
+//
+// bench speed's cloth stepped on 1 and on 2 threads, taking turns repeat by repeat (a busy
+// machine slows both alike), each repeat a multiple of 32 steps so that it holds its share of
+// the guard's energy check (every 32 steps, on the calling thread). World::thread_profile
+// records, for each step's pass (the job of the threads, FastEngine::pass), how long it took as
+// the step waited for it, and how long each thread worked in it (its time less its waits at the
+// barrier). With T the step, J its pass, W the busiest thread's work and B the threads' mean
+// work (2 threads; on 1 thread B1 is the pass's work and S1 = T1 - B1 the rest of the step),
+// the 2-thread step's excess over half the 1-thread step splits exactly into four parts:
+//
+//   T2 - T1 / 2 = (T2 - J2 - S1 / 2)   serial: what the step does outside its pass, one thread
+//               + (J2 - W2)            the wake and the barrier: the pass's time no thread worked
+//                                      for (the last thread to wake, the first to wait)
+//               + (W2 - B2)            imbalance: the busiest thread against the mean
+//               + (B2 - B1 / 2)        slower work: a thread's half took longer than half the
+//                                      whole (the memory they share; springs at the border of
+//                                      the two ranges, taken by both)
+//
+// Times 2 / T2, each is what two threads lose of a speed-up of 2: T1 / T2 = 2 - their sum.
+
+struct ThreadsSample {
+  double step = 0.0;       // [s] a step
+  ThreadProfile per_step;  // its pass, per step [s]
+};
+
+struct ThreadsRow {
+  int n = 0;
+  StepBytes bytes;
+  ThreadsSample one, two;     // the repeat of median step time on 1 and on 2 threads
+  double energy_check = 0.0;  // [s] the guard's energy check once (every 32 steps), fastest of 5
+
+  // What two threads lose of 2 (units of speed-up): they sum to 2 - speedup().
+  double speedup() const { return one.step / two.step; }
+  double lost(double seconds) const { return 2.0 * seconds / two.step; }
+  double lost_serial() const {
+    return lost(two.step - two.per_step.wall - (one.step - one.per_step.busy) / 2);
+  }
+  double lost_wake() const { return lost(two.per_step.wall - two.per_step.busiest); }
+  double lost_imbalance() const { return lost(two.per_step.busiest - two.per_step.busy); }
+  double lost_work() const { return lost(two.per_step.busy - one.per_step.busy / 2); }
+  // Of the serial part, the energy check's: a 32nd of it a step on either, of which a half-step
+  // share would be the 2-thread step's, were it split.
+  double lost_energy_check() const { return lost(energy_check / 32 / 2); }
+};
+
+ThreadsRow measure_threads(int n, int repeats, double min_seconds) {
+  ThreadsRow row;
+  row.n = n;
+  std::vector<std::unique_ptr<Scene>> scenes;
+  std::vector<ThreadProfile> profiles(2);
+  for (int threads : {1, 2}) {
+    scenes.push_back(std::make_unique<Scene>(
+        parse_scene(speed_cloth_scene(n, threads), "<bench roofline threads>")));
+    scenes.back()->world.thread_profile = &profiles[static_cast<size_t>(threads - 1)];
+  }
+  row.bytes = step_bytes(scenes[0]->world);
+  const auto steps = [](Scene& scene, long count) {
+    for (long s = 0; s < count; ++s)
+      scene.world.step(scene.dt);
+  };
+  for (auto& scene : scenes)
+    steps(*scene, 2);  // warm up: the caches, the guard's start, the threads
+  // Steps a repeat: a multiple of 32 that lasts min_seconds on 1 thread.
+  const Clock::time_point start = Clock::now();
+  steps(*scenes[0], 32);
+  const double batch = std::chrono::duration<double>(Clock::now() - start).count();
+  const long count = 32 * std::max(1L, std::lround(min_seconds / batch));
+  std::vector<std::vector<ThreadsSample>> samples(2);
+  for (int r = 0; r < repeats; ++r) {
+    for (size_t k = 0; k < 2; ++k) {
+      profiles[k] = ThreadProfile{};
+      const Clock::time_point begun = Clock::now();
+      steps(*scenes[k], count);
+      const double seconds = std::chrono::duration<double>(Clock::now() - begun).count();
+      const double per = 1.0 / static_cast<double>(count);
+      const ThreadProfile& p = profiles[k];
+      samples[k].push_back({seconds * per, {p.jobs, p.wall * per, p.busiest * per, p.busy * per}});
+      if (p.jobs != count) {
+        throw std::logic_error(fmt::format(
+            "bench roofline: {} steps on {} threads made {} passes of the threads; expected one "
+            "a step",
+            count, k + 1, p.jobs));
+      }
+    }
+  }
+  const auto median_sample = [](std::vector<ThreadsSample> all) {
+    std::sort(all.begin(), all.end(),
+              [](const ThreadsSample& a, const ThreadsSample& b) { return a.step < b.step; });
+    return all[all.size() / 2];
+  };
+  row.one = median_sample(samples[0]);
+  row.two = median_sample(samples[1]);
+  const World& world = scenes[0]->world;
+  row.energy_check = fastest_call(5, 0.0, [&] { world.guard.check_energy(world); });
+  return row;
+}
+
+// The model of a step on P cores: serial + max(work / P, bytes / bandwidth(P)) + wake(P).
+struct CoresModel {
+  double serial = 0.0;                                // [s] the 1-thread step outside its pass
+  double work = 0.0;                                  // [s] the 1-thread pass's work
+  double bytes = 0.0;                                 // [bytes] what a step must move
+  double gbs_1 = 0.0, gbs_2 = 0.0, gbs_socket = 0.0;  // [GB/s] 1, 2 threads; a socket, assumed
+  double wake_2 = 0.0;  // [s] a wake of 2 threads with a barrier in the job, nothing to do
+
+  double bandwidth(int cores) const {  // [bytes/s]
+    if (cores <= 1) return 1e9 * gbs_1;
+    if (cores == 2) return 1e9 * gbs_2;
+    return 1e9 * std::min(cores * gbs_2 / 2, gbs_socket);
+  }
+  // Each thread's arrival at the job's end and at its barrier is a turn at one shared counter:
+  // assumed to grow with the threads that arrive after the first.
+  double wake(int cores) const { return wake_2 * (cores - 1); }
+  double compute(int cores) const { return work / cores; }
+  double memory(int cores) const { return bytes / bandwidth(cores); }
+  double step(int cores) const {
+    return serial + std::max(compute(cores), memory(cores)) + wake(cores);
+  }
+  // What bounds P cores: the largest of the three terms after the serial part.
+  const char* bound(int cores) const {
+    const double c = compute(cores), m = memory(cores), w = wake(cores) + serial;
+    return c >= m && c >= w ? "compute" : m >= w ? "bandwidth" : "serial+wake";
+  }
+  // The cores at which the socket's bandwidth catches up with the compute: work / P = bytes /
+  // socket.
+  double bandwidth_caps_at() const { return work * gbs_socket * 1e9 / bytes; }
+};
+
+CoresModel cores_model(const ThreadsRow& r, const Memory& m, double wake_2) {
+  CoresModel model;
+  model.work = r.one.per_step.busy;
+  model.serial = r.one.step - model.work;
+  model.bytes = r.bytes.moved;
+  model.gbs_1 = m.copy_gbs;
+  model.gbs_2 = m.copy_gbs_2;
+  model.gbs_socket = m.socket_gbs;
+  model.wake_2 = wake_2;
+  return model;
+}
+
+std::string peak_memory() {
+  rusage usage{};
+  if (getrusage(RUSAGE_SELF, &usage) != 0) return "unknown";
+  return fmt::format("{:.0f} MB", static_cast<double>(usage.ru_maxrss) * 1024 * 1e-6);
 }
 
 // --- The table -----------------------------------------------------------------------------
@@ -357,11 +532,18 @@ int bench_roofline(RooflineOptions opt) {
       fastest_call(stream_repeats, seconds, [&] { bits |= read_words(m.a.data(), stream_words); });
   m.read_gbs = 8.0 * static_cast<double>(stream_words) / read_s * 1e-9;
   if (bits == 0) throw std::logic_error("the streaming read read nothing");
+  ThreadTeam pair(2);
+  m.copy_gbs_2 =
+      copy_gbs_threads(m, pair, 16.0 * static_cast<double>(stream_words), stream_repeats, seconds);
+  m.socket_gbs = opt.socket_gbs;
   fmt::print(
       "  memory: arrays of {:.0f} MiB each ({}), fastest of {} repeats\n"
       "    streaming copy, b = a xor s (8 bytes read and 8 written a word)  {:8.2f} GB/s\n"
+      "    the same copy on 2 threads, each its half                         {:8.2f} GB/s "
+      "({:.2f} times 1 thread)\n"
       "    streaming read, the or of every word                             {:8.2f} GB/s\n\n",
-      m.array_bytes / 1048576.0, m.why_size, stream_repeats, m.copy_gbs, m.read_gbs);
+      m.array_bytes / 1048576.0, m.why_size, stream_repeats, m.copy_gbs, m.copy_gbs_2,
+      m.copy_gbs_2 / m.copy_gbs, m.read_gbs);
 
   for (Row& row : rows) {
     row.copy_gbs = copy_gbs(m, row.bytes.touched, limit_repeats, seconds);
@@ -388,21 +570,84 @@ int bench_roofline(RooflineOptions opt) {
         r.bandwidth_ns, r.floor_ns(), r.compute_ns >= r.bandwidth_ns ? "compute" : "bandwidth",
         r.engine_ns, r.engine_ns / r.floor_ns());
   }
-  fmt::print("  (load average {} at the end)\n", load_average());
+
+  // Threads: 1 against 2, what two lose of 2, and the model for 8 and 16 cores.
+  std::vector<ThreadsRow> threads;
+  for (const Row& r : rows)
+    threads.push_back(measure_threads(r.n, opt.repeats, opt.min_seconds));
+  const double wake_2 = 1e-9 * wake_ns(2, 1, opt.quick ? 500 : 20000);
+  fmt::print(
+      "\n  threads: the same step on 1 and on 2 threads, taking turns, {} repeats of a multiple of "
+      "32 steps (the guard's\n  energy check comes every 32), the repeat of median time; ns per "
+      "spring-step. Two threads lose of a speed-up of 2:\n  serial, the step's work outside its "
+      "pass (of which the energy check); wake, the pass's time no thread worked;\n  imbalance, "
+      "the busiest thread over the mean; slower work, a thread's half over half of one thread's "
+      "whole.\n  They add up to 2 - speed-up. (A wake of 2 threads with one barrier and nothing "
+      "to do: {:.0f} ns.)\n",
+      opt.repeats, wake_2 * 1e9);
+  fmt::print("  {:>4} {:>9} {:>9} {:>8}  {:>8} {:>14} {:>7} {:>9} {:>11}\n", "N", "1 thread",
+             "2 threads", "speed-up", "serial", "(energy check)", "wake", "imbalance",
+             "slower work");
+  for (const ThreadsRow& t : threads) {
+    const double springs = static_cast<double>(t.bytes.springs);
+    fmt::print(
+        "  {:>4} {:>9.3f} {:>9.3f} {:>8.2f}  {:>8.3f} {:>14.3f} {:>7.3f} {:>9.3f} {:>11.3f}\n", t.n,
+        1e9 * t.one.step / springs, 1e9 * t.two.step / springs, t.speedup(), t.lost_serial(),
+        t.lost_energy_check(), t.lost_wake(), t.lost_imbalance(), t.lost_work());
+  }
+
+  fmt::print(
+      "\n  model of a step on P cores: serial + max(work / P, bytes / bandwidth(P)) + wake(P), "
+      "from this run:\n  serial and work, the 1-thread step outside and inside its pass; bytes, "
+      "what a step must move (above);\n  bandwidth(P), the streaming copy on 1 and 2 threads as "
+      "measured, past 2 min(P x the 2-thread copy's\n  share a core, {:.0f} GB/s), a server "
+      "socket's bandwidth: ASSUMED, not measured (--socket-gbs); wake(P), the\n  2-thread wake "
+      "with a barrier above, times P - 1 (assumed: each thread's arrival a turn at one shared "
+      "counter).\n  The 2-core model leaves out the imbalance and the slower work measured above. "
+      "ns per spring-step:\n",
+      m.socket_gbs);
+  fmt::print("  {:>4} {:>8} {:>9} {:>9} {:>9} {:>9} {:>8} {:>9} {:>8} {:>11} {:>14}\n", "N",
+             "serial", "work", "P=2 model", "measured", "P=8", "speed-up", "P=16", "speed-up",
+             "bound at 16", "bandwidth caps");
+  std::vector<CoresModel> models;
+  for (const ThreadsRow& t : threads) {
+    models.push_back(cores_model(t, m, wake_2));
+    const CoresModel& model = models.back();
+    const double ns = 1e9 / static_cast<double>(t.bytes.springs);
+    fmt::print(
+        "  {:>4} {:>8.3f} {:>9.3f} {:>9.3f} {:>9.3f} {:>9.3f} {:>8.2f} {:>9.3f} {:>8.2f} {:>11} "
+        "{:>14}\n",
+        t.n, ns * model.serial, ns * model.work, ns * model.step(2), ns * t.two.step,
+        ns * model.step(8), model.step(1) / model.step(8), ns * model.step(16),
+        model.step(1) / model.step(16), model.bound(16),
+        fmt::format("at {:.0f} cores", model.bandwidth_caps_at()));
+  }
+  fmt::print("  (load average {} at the end; peak memory of this run {})\n", load_average(),
+             peak_memory());
 
   if (!opt.csv.empty()) {
     const std::filesystem::path csv = opt.csv;
     if (csv.has_parent_path()) std::filesystem::create_directories(csv.parent_path());
     std::string table =
         "n,particles,springs,data_bytes,bytes_per_spring,copy_gb_per_s,compute_floor_ns,"
-        "bandwidth_floor_ns,floor_ns,engine_ns,engine_over_floor\n";
-    for (const Row& r : rows) {
+        "bandwidth_floor_ns,floor_ns,engine_ns,engine_over_floor,engine_1_thread_ns,"
+        "engine_2_threads_ns,speedup_2,lost_serial,lost_energy_check,lost_wake,lost_imbalance,"
+        "lost_work,model_2_ns,model_8_ns,model_16_ns\n";
+    for (size_t k = 0; k < rows.size(); ++k) {
+      const Row& r = rows[k];
+      const ThreadsRow& t = threads[k];
+      const CoresModel& model = models[k];
+      const double ns = 1e9 / static_cast<double>(t.bytes.springs);
       fmt::format_to(std::back_inserter(table),
-                     "{},{},{},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},"
-                     "{:.6g},{:.6g}\n",
+                     "{},{},{},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},"
+                     "{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},"
+                     "{:.6g}\n",
                      r.n, r.bytes.particles, r.bytes.springs, r.bytes.touched,
                      r.bytes.moved / static_cast<double>(r.bytes.springs), r.copy_gbs, r.compute_ns,
-                     r.bandwidth_ns, r.floor_ns(), r.engine_ns, r.engine_ns / r.floor_ns());
+                     r.bandwidth_ns, r.floor_ns(), r.engine_ns, r.engine_ns / r.floor_ns(),
+                     ns * t.one.step, ns * t.two.step, t.speedup(), t.lost_serial(),
+                     t.lost_energy_check(), t.lost_wake(), t.lost_imbalance(), t.lost_work(),
+                     ns * model.step(2), ns * model.step(8), ns * model.step(16));
     }
     write_whole_file(csv, table);
     fmt::print("\n  wrote {}\n", csv.string());
@@ -434,6 +679,12 @@ void add_bench_roofline_command(CLI::App& bench) {
                    "Size [MiB] of each array of the memory figures (default: 4 x the last-level "
                    "cache, within 64 to 2048)")
       ->check(CLI::Range(1.0, 65536.0));
+  roofline
+      ->add_option("--socket-gbs", o.socket_gbs,
+                   "Bandwidth [GB/s] the model of 8 and 16 cores assumes for a server socket (an "
+                   "assumption, not a measurement)")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
   roofline->add_option("--csv", o.csv, "Write one row per cloth size to this CSV file");
   roofline->add_flag("--quick", o.quick,
                      "Sizes 16 and 32, short repeats, 16 MiB arrays (for tests)");

@@ -175,8 +175,38 @@ void FastEngine::pass(const World& world, const Matrix3X& x, const Matrix3X& v, 
   Copies& c = copies_;
   c.resize(n);
   f.resize(3, n);
-  std::atomic<bool> start_within = true;
-  world.for_particles([&](Index begin, Index end) {
+  // The effects with a fast form that lead the world's list share one job of the threads with
+  // the copies: each thread copies its particles, waits at the barrier until every thread has
+  // (a spring at the border of two ranges reads the other range's x and v), then lets every one
+  // of those effects add its forces on its own particles. When they are the whole list, it then
+  // moves its particles (move) or copies their forces back (a sum alone): one wake of the
+  // threads for all of it. Later effects take passes of their own (below).
+  size_t lead = 0;
+  while (lead < effects.size() && forces_[lead].on)
+    ++lead;
+  const bool all_fast = lead == effects.size();
+  const bool check_end = all_fast && move && checks && checks->end;
+  std::atomic<bool> start_within = true, end_within = true;
+  // Particles [begin, end) summed and moved block by block (pass_block): every effect adds its
+  // forces on the block, then the block moves, while its x, v and f are still in the cache.
+  // These particles' forces are final: no other block or thread adds to them. The others read x
+  // and v from the copies, so moving these in x and v changes nothing they see.
+  const auto sum_and_move = [&](Index begin, Index end) {
+    const Particles& p = world.particles;
+    const Index block = std::max<Index>(pass_block, 1);
+    for (Index b0 = begin; b0 < end; b0 += block) {
+      const Index b1 = std::min(b0 + block, end);
+      for (const Force& force : forces_)
+        force.fast->add(p, c.x, c.v, c.f, b0, b1);
+      for (Index c0 = b0; c0 < b1; c0 += kPassChunk) {
+        const Index c1 = std::min(c0 + kPassChunk, b1);
+        from_soa(c0, c1, c.f.data(), c.f.cols(), f.data());
+        (*move)(c0, c1, &c);
+        if (check_end && !world.guard.within(p.x, p.v, c0, c1)) end_within = false;
+      }
+    }
+  };
+  world.for_particles_with_barrier([&](Index begin, Index end, const Barrier& barrier) {
     if (!checks) {
       to_soa(begin, end, x.data(), c.x.data(), c.x.cols());
       to_soa(begin, end, v.data(), c.v.data(), c.v.cols());
@@ -188,10 +218,26 @@ void FastEngine::pass(const World& world, const Matrix3X& x, const Matrix3X& v, 
       if (!x_within || !v_within) start_within = false;
     }
     c.f.middleCols(begin, end - begin).setZero();
+    if (lead == 0) return;
+    barrier.wait();
+    // A bad state stops every thread here, before anything moves (the guard's error follows).
+    if (!start_within) return;
+    if (all_fast && move) {
+      sum_and_move(begin, end);
+      return;
+    }
+    for (size_t k = 0; k < lead; ++k)
+      forces_[k].fast->add(world.particles, c.x, c.v, c.f, begin, end);
+    if (all_fast) from_soa(begin, end, c.f.data(), c.f.cols(), f.data());
   });
   // The step's state was bad before it began: the guard names the particle and throws, before
   // anything moves.
   if (!start_within) world.guard.check(world, /*before_step=*/true);
+  if (check_end) {
+    checks->end_checked = true;
+    checks->end_within = end_within;
+  }
+  if (all_fast) return;
   const auto move_f = [&](bool soa) {
     world.for_particles([&](Index begin, Index end) {
       if (soa) {
@@ -201,11 +247,11 @@ void FastEngine::pass(const World& world, const Matrix3X& x, const Matrix3X& v, 
       }
     });
   };
-  // The effects in the world's order; f moves to whichever layout the next effect works on.
-  // Consecutive effects with a fast form share one pass of the threads: each thread lets every
-  // one of them add its forces on the thread's own particles.
+  // The rest of the effects in the world's order; f moves to whichever layout the next effect
+  // works on. Consecutive effects with a fast form share one pass of the threads: each thread
+  // lets every one of them add its forces on the thread's own particles.
   bool in_soa = true;
-  for (size_t e = 0; e < effects.size();) {
+  for (size_t e = lead; e < effects.size();) {
     if (!forces_[e].on) {
       if (in_soa) move_f(false);
       in_soa = false;
@@ -218,38 +264,10 @@ void FastEngine::pass(const World& world, const Matrix3X& x, const Matrix3X& v, 
       ++last;
     if (!in_soa) move_f(true);
     in_soa = true;
-    const bool move_here = move && last == effects.size();
-    const bool check_end = move_here && checks && checks->end;
-    std::atomic<bool> end_within = true;
     world.for_particles([&](Index begin, Index end) {
-      if (!move_here) {
-        for (size_t k = e; k < last; ++k)
-          forces_[k].fast->add(world.particles, c.x, c.v, c.f, begin, end);
-        return;
-      }
-      // Block by block (pass_block): every effect adds its forces on the block, then the block
-      // moves, while its x, v and f are still in the cache. These particles' forces are final:
-      // no other block or thread adds to them. The others read x and v from the copies, so
-      // moving these in x and v changes nothing they see.
-      const Particles& p = world.particles;
-      const Index block = std::max<Index>(pass_block, 1);
-      for (Index b0 = begin; b0 < end; b0 += block) {
-        const Index b1 = std::min(b0 + block, end);
-        for (size_t k = e; k < last; ++k)
-          forces_[k].fast->add(p, c.x, c.v, c.f, b0, b1);
-        for (Index c0 = b0; c0 < b1; c0 += kPassChunk) {
-          const Index c1 = std::min(c0 + kPassChunk, b1);
-          from_soa(c0, c1, c.f.data(), c.f.cols(), f.data());
-          (*move)(c0, c1, &c);
-          if (check_end && !world.guard.within(p.x, p.v, c0, c1)) end_within = false;
-        }
-      }
+      for (size_t k = e; k < last; ++k)
+        forces_[k].fast->add(world.particles, c.x, c.v, c.f, begin, end);
     });
-    if (check_end) {
-      checks->end_checked = true;
-      checks->end_within = end_within;
-    }
-    if (move_here) return;
     e = last;
   }
   if (in_soa) move_f(false);

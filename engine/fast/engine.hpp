@@ -14,9 +14,14 @@
 //      the forces on that range only: no two threads write the same force;
 //   3. copy f back.
 //
+// With threads, the copy and the sums are one job of the team: each thread copies its own
+// particles, waits at a barrier until every thread has (a spring at the border of two ranges
+// reads the other range's copies), then sums its particles' forces and copies them back. A
+// force sum wakes the threads once (ThreadTeam::sync, World::for_particles_with_barrier).
+//
 // A step of an Euler method (each particle moves by its own force alone) goes further: each
 // particle moves right there, in the pass that summed its force, reading its state from the
-// copies. That pass takes each thread's particles a block at a time (pass_block): every effect
+// copies: the whole step is that one job. That pass takes each thread's particles a block at a time (pass_block): every effect
 // adds its forces on the block, then the block moves. The pass also checks each particle for the
 // guard as it copies it and after it moves, and the ground and the sphere, when they lead the
 // world's post-step effects, push each particle out right after it moves: the same checks and
@@ -155,7 +160,9 @@ class FastEngine final : public Backend {
   // once: where the last effect has a fast form, each thread calls it on its own particles,
   // kPassChunk at a time, right after copying their forces back. With `checks`, (x, v) is the
   // state a step starts from: it is checked as it is copied (a bad one throws the guard's error
-  // before any particle moves), and the new state as it is moved if checks->end.
+  // before any particle moves), and the new state as it is moved if checks->end. When every
+  // effect has a fast form, all of it is one job of the threads (one wake), a barrier between
+  // the copies and the sums; effects without one add passes of their own.
   void pass(const World& world, const Matrix3X& x, const Matrix3X& v, Matrix3X& f,
             const MoveRange* move = nullptr, PassChecks* checks = nullptr);
 

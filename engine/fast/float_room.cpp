@@ -120,23 +120,22 @@ BackendStep FloatRoom::step(World& world, double dt) {
   CopiesOf<float>& c = copies_;
   c.resize(n);
   p.f.resize(3, n);
-  // 1. x and v rounded into the copies, checked for the guard as they go; f cleared.
-  std::atomic<bool> start_within = true;
-  world.for_particles([&](Index begin, Index end) {
+  // One job of the threads, as the fast path's pass (FastEngine::pass): 1. x and v rounded into
+  // the copies, checked for the guard as they go, f cleared; then, once every thread has copied
+  // its particles (a spring at a border reads the other range's), 2-3. block by block, every
+  // effect adds its forces on the block, then the block moves, and is checked.
+  const float h = static_cast<float>(dt);
+  const auto move = symplectic ? move_in_float<true> : move_in_float<false>;
+  std::atomic<bool> start_within = true, end_within = true;
+  world.for_particles_with_barrier([&](Index begin, Index end, const Barrier& barrier) {
     const bool x_within =
         to_soa_within(begin, end, p.x.data(), c.x.data(), c.x.cols(), world.guard.max_position);
     const bool v_within =
         to_soa_within(begin, end, p.v.data(), c.v.data(), c.v.cols(), world.guard.max_speed);
     if (!x_within || !v_within) start_within = false;
     c.f.middleCols(begin, end - begin).setZero();
-  });
-  if (!start_within) world.guard.check(world, /*before_step=*/true);
-  // 2-3. Block by block, as the fast path's pass (FastEngine::pass): every effect adds its
-  // forces on the block, then the block moves, and is checked.
-  const float h = static_cast<float>(dt);
-  const auto move = symplectic ? move_in_float<true> : move_in_float<false>;
-  std::atomic<bool> end_within = true;
-  world.for_particles([&](Index begin, Index end) {
+    barrier.wait();
+    if (!start_within) return;  // nothing moves; the guard's error follows
     for (Index b0 = begin; b0 < end; b0 += kPassBlock) {
       const Index b1 = std::min(b0 + kPassBlock, end);
       for (const FastForceSlot<float>& force : forces_)
@@ -149,6 +148,7 @@ BackendStep FloatRoom::step(World& world, double dt) {
       }
     }
   });
+  if (!start_within) world.guard.check(world, /*before_step=*/true);
   ++world.force_evaluations;
   ++world.backend_evaluations;
   return {true, 0, end_within};

@@ -1,9 +1,11 @@
 # bench_csv.cmake: the CSV contract the bench commands' test scripts share (include() it).
 #
-# bench_csv_rows(FILE HEADER FIRST OUT): FILE's first line is HEADER; every other row has as many
-# fields as HEADER, and its fields FIRST and after (counted from 0) are positive finite numbers.
-# OUT receives the rows, each a line of comma-separated fields.
+# bench_csv_rows(FILE HEADER FIRST OUT [SIGNED...]): FILE's first line is HEADER; every other row
+# has as many fields as HEADER, and its fields FIRST and after (counted from 0) are positive finite
+# numbers, except those whose indices follow OUT, which are finite numbers of either sign (a
+# difference of two measurements). OUT receives the rows, each a line of comma-separated fields.
 function(bench_csv_rows file header first out)
+  set(signed ${ARGN})
   file(STRINGS ${file} lines)
   list(GET lines 0 found)
   if(NOT found STREQUAL header)
@@ -21,6 +23,14 @@ function(bench_csv_rows file header first out)
     endif()
     foreach(index RANGE ${first} ${last})
       list(GET fields ${index} value)
+      list(FIND signed ${index} at)
+      if(NOT at EQUAL -1)
+        if(NOT value MATCHES "^-?[0-9]+(\\.[0-9]+)?(e[-+][0-9]+)?$")
+          message(FATAL_ERROR "row '${line}': field ${index} is '${value}'; expected a finite "
+                              "number")
+        endif()
+        continue()
+      endif()
       # A positive finite number: digits, maybe a fraction and an exponent; no nan, inf or sign.
       if(NOT value MATCHES "^[0-9]+(\\.[0-9]+)?(e[-+][0-9]+)?$" OR value MATCHES "^0(\\.0+)?$")
         message(FATAL_ERROR "row '${line}': field ${index} is '${value}'; expected a positive "

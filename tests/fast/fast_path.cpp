@@ -19,6 +19,7 @@
 #include <vector>
 
 #include "clothlab/bodies/cloth.hpp"
+#include "clothlab/core/guard.hpp"
 #include "clothlab/core/threads.hpp"
 #include "clothlab/forces/aerodynamics.hpp"
 #include "clothlab/forces/bending.hpp"
@@ -768,6 +769,114 @@ TEST_CASE("fast path: a thread team runs every job once and passes on what a job
                   std::runtime_error);
   team.run([&](int t) { sum += t; });  // still usable
   CHECK(sum == 100 * 6 + 3);
+}
+
+TEST_CASE("fast path: a job's threads meet at sync(), and a throw there leaves none waiting") {
+  for (int size = 1; size <= 4; ++size) {
+    CAPTURE(size);
+    clothlab::ThreadTeam team(size);
+    // Each thread writes its slot, then, past the barrier, reads every slot: it must find what
+    // every other thread wrote in this round, never the last round's value.
+    std::vector<long> slots(static_cast<size_t>(size), -1);
+    std::atomic<long> stale{0};
+    constexpr long kRounds = 300;
+    for (long round = 0; round < kRounds; ++round) {
+      team.run([&](int t) {
+        slots[static_cast<size_t>(t)] = round * 10 + t;
+        team.sync();
+        for (int u = 0; u < size; ++u)
+          stale += slots[static_cast<size_t>(u)] != round * 10 + u;
+        team.sync();  // a second meeting in the same job
+      });
+    }
+    CHECK(stale == 0);
+    CHECK(team.runs() == kRounds);  // two meetings a job, no more wakes
+    // A job that throws on one thread before the barrier, the others waiting there: run()
+    // returns and rethrows that error, and the team still works.
+    for (int thrower = 0; thrower < size; ++thrower) {
+      CAPTURE(thrower);
+      CHECK_THROWS_WITH_AS(team.run([&](int t) {
+        if (t == thrower) throw std::runtime_error("the first part failed");
+        team.sync();
+        team.sync();
+      }),
+                           "the first part failed", std::runtime_error);
+      std::atomic<int> met{0};
+      team.run([&](int) {
+        team.sync();
+        ++met;
+      });
+      CHECK(met == size);
+    }
+  }
+}
+
+TEST_CASE("fast path: an Euler step wakes the threads once, and so does a force sum") {
+  // The copy into the fast layout and the pass that sums and moves are one job of the threads,
+  // with a barrier inside it (FastEngine::pass): each step wakes them once. Buoyancy (no fast
+  // form) is taken out, so that every effect has one; the ground rides along in the pass.
+  const auto no_buoyancy = [](clothlab::World& w) {
+    std::erase_if(w.force_effects, [](const auto& e) { return e->name() == "buoyancy"; });
+  };
+  for (const char* method : {"symplectic-euler", "explicit-euler"}) {
+    for (int threads : {2, 3}) {
+      CAPTURE(method);
+      CAPTURE(threads);
+      clothlab::Scene scene = run(cloth("", method), true, threads, 1, no_buoyancy);
+      REQUIRE(engine_of(scene.world).plan().ends_with("drag+"));
+      const long before = scene.world.thread_wakes();
+      constexpr int kSteps = 40;  // past an energy check (every 32 steps), which wakes nobody
+      for (int s = 0; s < kSteps; ++s)
+        scene.world.step(scene.dt);
+      CHECK(scene.world.thread_wakes() - before == kSteps);
+      // A force sum alone (what a multi-stage method asks for): the copy, the sum and the
+      // forces copied back in one job too.
+      clothlab::Matrix3X f;
+      const long before_sum = scene.world.thread_wakes();
+      scene.world.compute_forces(scene.world.particles.x, scene.world.particles.v, f);
+      CHECK(scene.world.thread_wakes() - before_sum == 1);
+      clothlab::Matrix3X f_readable(3, scene.world.particles.size());
+      scene.world.compute_forces_readable(scene.world.particles.x, scene.world.particles.v,
+                                          f_readable);
+      CHECK(identical(f, f_readable));
+    }
+  }
+}
+
+TEST_CASE("fast path: a state spoiled between steps stops the one-job pass before anything moves") {
+  // Every thread copies and checks its particles, meets the others at the barrier, and stops
+  // there if any found a bad value: the guard then names the step about to be taken and the
+  // particle, and no particle has moved. The spoiled particle in the first range, the last, and
+  // (on 3 threads) the middle one.
+  const auto no_buoyancy = [](clothlab::World& w) {
+    std::erase_if(w.force_effects, [](const auto& e) { return e->name() == "buoyancy"; });
+  };
+  for (int threads : {1, 2, 3}) {
+    for (const Index bad : {Index{5}, Index{900}, Index{1840}}) {
+      CAPTURE(threads);
+      CAPTURE(bad);
+      clothlab::Scene scene = run(cloth(""), true, threads, 10, no_buoyancy);
+      clothlab::World& world = scene.world;
+      world.particles.x(1, bad) = std::numeric_limits<double>::infinity();
+      const Matrix3X x = world.particles.x, v = world.particles.v;
+      std::string what;
+      try {
+        world.step(scene.dt);
+      } catch (const clothlab::SimulationError& e) {
+        what = e.what();
+        CHECK(e.step() == 11);
+        CHECK(e.particle() == bad);
+      }
+      CHECK(what.find("blew up before step 11") != std::string::npos);
+      CHECK(identical(world.particles.x, x));
+      CHECK(identical(world.particles.v, v));
+      CHECK(world.steps == 10);
+      // Mended, the world steps on, the threads still there.
+      world.particles.x(1, bad) = 0.0;
+      world.step(scene.dt);
+      CHECK(world.steps == 11);
+    }
+  }
 }
 
 namespace {

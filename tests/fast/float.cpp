@@ -87,6 +87,19 @@ TEST_CASE("float: the same bits on 1 to 4 threads") {
   }
 }
 
+TEST_CASE("float: a step wakes the threads once") {
+  // The copy into the float copies and the pass that sums and moves are one job of the threads,
+  // with a barrier inside it, as on the fast path.
+  for (int threads : {2, 4}) {
+    CAPTURE(threads);
+    clothlab::Scene scene = steps(cloth(), 1, threads);
+    const long before = scene.world.thread_wakes();
+    for (int s = 0; s < 40; ++s)
+      scene.world.step(scene.dt);
+    CHECK(scene.world.thread_wakes() - before == 40);
+  }
+}
+
 TEST_CASE("float: explicit Euler moves with the old velocity") {
   // One step from rest under gravity alone: symplectic Euler moves the free particles by
   // g dt^2, explicit Euler not at all (it moves with v = 0). A float room that took the wrong

@@ -29,6 +29,10 @@ void wait_until(Done done) {
   }
 }
 
+// Thrown by sync() on the threads that were waiting there for a job that threw on another
+// thread: it ends their jobs, and run() rethrows the other thread's error, not this.
+struct Abandoned {};
+
 }  // namespace
 
 ThreadTeam::ThreadTeam(int size) : size_(std::max(1, size)) {
@@ -65,8 +69,42 @@ int ThreadTeam::hardware_threads() {
 }
 
 void ThreadTeam::record(std::exception_ptr error) {
-  const std::lock_guard<std::mutex> lock(error_mutex_);
-  if (!error_) error_ = error;
+  {
+    const std::lock_guard<std::mutex> lock(error_mutex_);
+    if (!error_) error_ = error;
+  }
+  // The threads waiting in sync() for this one would wait forever: move the round on, so that
+  // they look, and find failed_.
+  failed_.store(true);
+  rounds_.fetch_add(1);
+  rounds_.notify_all();
+}
+
+void ThreadTeam::job_of(int t) {
+  try {
+    (*job_)(t);
+  } catch (const Abandoned&) {
+    // Another thread's job threw: its error is the one recorded.
+  } catch (...) {
+    record(std::current_exception());
+  }
+}
+
+void ThreadTeam::sync() {
+  if (size_ == 1) return;
+  // The round is read before arriving, and only the last thread to arrive moves it on, so no
+  // thread can miss the round it waits for.
+  const unsigned round = rounds_.load();
+  if (arrived_.fetch_add(1) + 1 == size_) {
+    arrived_.store(0);  // before the round moves on: no thread arrives at the next one earlier
+    rounds_.fetch_add(1);
+    rounds_.notify_all();
+  } else {
+    wait_until([&] { return rounds_.load() != round || failed_.load(); });
+    for (unsigned now = rounds_.load(); now == round && !failed_.load(); now = rounds_.load())
+      rounds_.wait(now);
+  }
+  if (failed_.load()) throw Abandoned{};
 }
 
 void ThreadTeam::run(const std::function<void(int)>& job) {
@@ -77,14 +115,12 @@ void ThreadTeam::run(const std::function<void(int)>& job) {
   }
   job_ = &job;
   error_ = nullptr;
+  arrived_.store(0);
+  failed_.store(false);
   busy_.store(size_ - 1);
   generation_.fetch_add(1);  // publishes job_ to the workers
   generation_.notify_all();
-  try {
-    job(0);
-  } catch (...) {
-    record(std::current_exception());
-  }
+  job_of(0);
   wait_until([&] { return busy_.load() == 0; });
   for (int busy = busy_.load(); busy != 0; busy = busy_.load())
     busy_.wait(busy);
@@ -100,13 +136,64 @@ void ThreadTeam::work(int t) {
       generation_.wait(now);
     seen = generation_.load();
     if (stop_.load()) return;
-    try {
-      (*job_)(t);
-    } catch (...) {
-      record(std::current_exception());
-    }
+    job_of(t);
     if (busy_.fetch_sub(1) == 1) busy_.notify_one();
   }
+}
+
+void Barrier::wait() const {
+  if (!team_) return;
+  if (!waited_) {
+    team_->sync();
+    return;
+  }
+  const auto start = std::chrono::steady_clock::now();
+  team_->sync();
+  *waited_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+void for_ranges_with_barrier(
+    ThreadTeam* team, Index n,
+    const std::function<void(Index begin, Index end, const Barrier& barrier)>& range,
+    ThreadProfile* profile) {
+  const int parts = team ? team->size() : 1;
+  const auto piece = [&](int t, ThreadTeam* meet, double* waited) {
+    range(n * t / parts, n * (t + 1) / parts, Barrier(meet, waited));
+  };
+  if (!profile) {
+    if (parts == 1) {
+      piece(0, nullptr, nullptr);
+    } else {
+      team->run([&](int t) { piece(t, team, nullptr); });
+    }
+    return;
+  }
+  using Clock = std::chrono::steady_clock;
+  const auto since = [](Clock::time_point start) {
+    return std::chrono::duration<double>(Clock::now() - start).count();
+  };
+  std::vector<double> work(static_cast<size_t>(parts), 0.0);  // waits first, then the work
+  const Clock::time_point start = Clock::now();
+  const auto timed_piece = [&](int t) {
+    const Clock::time_point begun = Clock::now();
+    double& waited = work[static_cast<size_t>(t)];
+    piece(t, parts == 1 ? nullptr : team, &waited);
+    waited = since(begun) - waited;
+  };
+  if (parts == 1) {
+    timed_piece(0);
+  } else {
+    team->run(timed_piece);
+  }
+  profile->wall += since(start);
+  ++profile->jobs;
+  double busiest = 0.0, sum = 0.0;
+  for (const double w : work) {
+    busiest = std::max(busiest, w);
+    sum += w;
+  }
+  profile->busiest += busiest;
+  profile->busy += sum / parts;
 }
 
 }  // namespace clothlab

@@ -4,6 +4,10 @@
 // threads, not for starting them. The work is split by the caller, never by the team: each
 // thread gets a contiguous range of particles, and a step's result does not depend on how many
 // threads took it (see engine/fast/engine.hpp).
+//
+// A job that must wait, half way, for every thread to finish a first part (a pass that reads
+// what the others' first part wrote) calls sync() there: the threads meet without being put to
+// sleep and woken again, so the two parts cost one wake, not two.
 #pragma once
 
 #include <atomic>
@@ -34,13 +38,21 @@ class ThreadTeam {
   // (a barrier), the cost a step pays per pass over the particles (bench methods --speed).
   long runs() const { return runs_; }
 
+  // Inside a job of run(), on every thread of the team: returns once every thread has called it
+  // as often as this one (a barrier within the job; no thread sleeps for it unless it waits
+  // long). Every thread's job must call it the same number of times. If a job throws on one
+  // thread, the others stop waiting here and end their jobs, and run() rethrows the error.
+  void sync();
+
   // The threads this machine can run at once (at least 1).
   static int hardware_threads();
 
  private:
   void work(int t);
   void stop();  // ends and joins the workers
+  // Keeps the first error of a job and releases the threads waiting in sync().
   void record(std::exception_ptr error);
+  void job_of(int t);  // runs job_(t), recording what it throws
 
   int size_;
   long runs_ = 0;
@@ -48,6 +60,11 @@ class ThreadTeam {
   std::atomic<unsigned> generation_{0};  // one more for every job handed out
   std::atomic<int> busy_{0};             // workers still running the current job
   std::atomic<bool> stop_{false};
+  // sync(): the threads that have reached it in this round, and the rounds completed (each
+  // thread waits for the count of rounds to move). failed_: a job threw, nobody waits more.
+  std::atomic<int> arrived_{0};
+  std::atomic<unsigned> rounds_{0};
+  std::atomic<bool> failed_{false};
   std::mutex error_mutex_;
   std::exception_ptr error_;
   std::vector<std::thread> workers_;
@@ -64,5 +81,37 @@ void for_ranges(ThreadTeam* team, Index n, const Range& range) {
   const Index parts = team->size();
   team->run([&](int t) { range(n * t / parts, n * (t + 1) / parts); });
 }
+
+// What a range of for_ranges_with_barrier may wait at: wait() returns once every thread of the
+// job has reached it (ThreadTeam::sync); on one thread it returns at once.
+class Barrier {
+ public:
+  // waited: if not null, the seconds this thread spends in wait() are added there.
+  explicit Barrier(ThreadTeam* team, double* waited = nullptr) : team_(team), waited_(waited) {}
+  void wait() const;
+
+ private:
+  ThreadTeam* team_;
+  double* waited_;
+};
+
+// Where the threads' time went in the jobs of for_ranges_with_barrier, summed over the jobs, for
+// `clothlab bench roofline`, which asks why two threads do not take half one's time. A thread's
+// work in a job is its time in the job less its waits at the barrier.
+struct ThreadProfile {
+  long jobs = 0;
+  double wall = 0.0;     // [s] each job, from the call to the return, as the caller waited for it
+  double busiest = 0.0;  // [s] the work of the thread that worked longest in each job
+  double busy = 0.0;     // [s] the threads' work in each job, averaged over the threads
+};
+
+// for_ranges, where range(begin, end, barrier) may call barrier.wait() between two parts of its
+// work that must not overlap across threads: all of it one job, one wake of the threads. Every
+// range must call it the same number of times, an empty range too. With a profile, each job
+// adds its times there (two clock reads a thread and a wait more).
+void for_ranges_with_barrier(
+    ThreadTeam* team, Index n,
+    const std::function<void(Index begin, Index end, const Barrier& barrier)>& range,
+    ThreadProfile* profile = nullptr);
 
 }  // namespace clothlab

@@ -63,6 +63,11 @@ void World::for_particles(const std::function<void(Index begin, Index end)>& ran
   for_ranges(team(), particles.size(), range);
 }
 
+void World::for_particles_with_barrier(
+    const std::function<void(Index begin, Index end, const Barrier& barrier)>& range) const {
+  for_ranges_with_barrier(team(), particles.size(), range, thread_profile);
+}
+
 void World::for_items(Index n, const std::function<void(Index begin, Index end)>& range) const {
   for_ranges(team(), n, range);
 }

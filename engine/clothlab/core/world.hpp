@@ -64,6 +64,9 @@ class World {
   // Threads a step may use (the backend, the guard); 1: this one only. ([engine] threads in a
   // scene, `clothlab run --threads N`.)
   int threads = 1;
+  // When set (by `clothlab bench roofline`), the passes of for_particles_with_barrier add there
+  // where their threads' time went (ThreadProfile).
+  ThreadProfile* thread_profile = nullptr;
 
   // Takes one step of dt [s] (steps 1-5 and the substep contract above).
   void step(double dt);
@@ -79,6 +82,10 @@ class World {
   // range on one of the `threads` threads: for loops over particles whose iterations are
   // independent (the guard's checks, a backend's passes).
   void for_particles(const std::function<void(Index begin, Index end)>& range) const;
+  // The same, where range may wait at barrier.wait() until every thread has done the part of its
+  // work before it (for_ranges_with_barrier): a pass in two parts for one wake of the threads.
+  void for_particles_with_barrier(
+      const std::function<void(Index begin, Index end, const Barrier& barrier)>& range) const;
   // The same for any n items (a backend's loop over independent constraints): contiguous
   // ranges that cover [0, n) once each, one a thread.
   void for_items(Index n, const std::function<void(Index begin, Index end)>& range) const;
