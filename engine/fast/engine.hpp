@@ -21,11 +21,11 @@
 //
 // A step of an Euler method (each particle moves by its own force alone) goes further: each
 // particle moves right there, in the pass that summed its force, reading its state from the
-// copies: the whole step is that one job. That pass takes each thread's particles a block at a time (pass_block): every effect
-// adds its forces on the block, then the block moves. The pass also checks each particle for the
-// guard as it copies it and after it moves, and the ground and the sphere, when they lead the
-// world's post-step effects, push each particle out right after it moves: the same checks and
-// the same contacts, without passes of their own over the whole state.
+// copies: the whole step is that one job. That pass takes each thread's particles a block at a time
+// (pass_block): every effect adds its forces on the block, then the block moves. The pass also
+// checks each particle for the guard as it copies it and after it moves, and the ground and the
+// sphere, when they lead the world's post-step effects, push each particle out right after it
+// moves: the same checks and the same contacts, without passes of their own over the whole state.
 //
 // Each particle receives the same floating-point operations in the same order as on the
 // lecture's path, so the two agree bit for bit, with any number of threads and any block size
