@@ -1,6 +1,8 @@
 #include "clothlab/after_step/spatial_hash.hpp"
 
 #include <algorithm>
+#include <limits>
+#include <type_traits>
 
 #include <fmt/format.h>
 
@@ -10,7 +12,7 @@ namespace clothlab {
 
 void throw_slot_outside(const Cell& c, std::size_t table_size, std::size_t slot) {
   // A negative slot computed on signed integers comes back as a size_t near 2^64.
-  const bool negative = slot > (std::size_t{1} << 63);
+  const bool negative = slot > std::numeric_limits<std::size_t>::max() / 2;
   throw KernelAnswerError(
       "ex10.1",
       fmt::format("cell_hash(cell ({}, {}, {}), {}) returned the slot {}, but a table of {} slots "
@@ -18,7 +20,7 @@ void throw_slot_outside(const Cell& c, std::size_t table_size, std::size_t slot)
                   c.ix, c.iy, c.iz, table_size, slot, table_size, table_size - 1,
                   negative ? fmt::format(" ({} as a signed number: compute on std::uint64_t, "
                                          "where nothing is negative)",
-                                         static_cast<long long>(slot))
+                                         static_cast<std::make_signed_t<std::size_t>>(slot))
                            : std::string()));
 }
 

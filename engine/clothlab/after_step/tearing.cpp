@@ -1,6 +1,7 @@
 #include "clothlab/after_step/tearing.hpp"
 
 #include <algorithm>
+#include <limits>
 #include <set>
 
 #include <fmt/format.h>
@@ -39,7 +40,7 @@ void check_tears(const std::vector<size_t>& torn, size_t count) {
           fmt::format("select_tears returned the position {}, but there are {} springs, at "
                       "positions 0 to {}{}",
                       k, count, count - 1,
-                      k > count + (size_t{1} << 62)
+                      k > std::numeric_limits<size_t>::max() / 2
                           ? " (a negative number turned into a size_t: check what you subtract)"
                           : ""));
     }

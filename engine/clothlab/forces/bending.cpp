@@ -16,7 +16,9 @@ SpringSet bending_springs(const ClothGrid& grid, double ks, double kd, const Mat
 
 void check_bending_pairs(const std::vector<IndexPair>& pairs, Index rows, Index cols) {
   const Index n = rows * cols;
-  for (const auto& [a, b] : pairs) {
+  for (const IndexPair& pair : pairs) {
+    // Named, not a structured binding: the web build's Clang 14 lets no lambda capture one.
+    const Index a = pair.first, b = pair.second;
     const auto fail = [&](const std::string& why) {
       throw KernelAnswerError(
           "ex04.1", fmt::format("bending_pairs({}, {}) returned the pair ({}, {}): {}", rows, cols,
