@@ -192,6 +192,29 @@ template <class S, bool Uniform>
   }
 }
 
+// forces_of_run on springs 0 .. count - 1 in whole vectors: the springs up to the last multiple
+// of kVectorLanes<S> (vectorise.hpp), then the last kVectorLanes<S> springs once more, which
+// overlap the first part by less than a vector and write there again what it wrote: each lane's
+// f1 is the kernel on that spring's own inputs, the same operations whichever lane takes it, so
+// the same bits. The compiler's own remainder (narrower vectors, then one spring at a time, each
+// at about twice the cost of a lane: SPEED.md) is never taken, except by a run shorter than one
+// vector.
+template <class S, bool Uniform>
+void forces_in_vectors(Index count, Index nx, Index nv, const S* x1, const S* x2, const S* v1,
+                       const S* v2, const double* ks, const double* kd, const double* l0, S* f1x,
+                       S* f1y, S* f1z) {
+  constexpr Index kLanes = kVectorLanes<S>;
+  const Index whole = count - count % kLanes;
+  if (whole == count || whole == 0) {
+    forces_of_run<S, Uniform>(count, nx, nv, x1, x2, v1, v2, ks, kd, l0, f1x, f1y, f1z);
+    return;
+  }
+  forces_of_run<S, Uniform>(whole, nx, nv, x1, x2, v1, v2, ks, kd, l0, f1x, f1y, f1z);
+  const Index t = count - kLanes, k = Uniform ? 0 : t;
+  forces_of_run<S, Uniform>(kLanes, nx, nv, x1 + t, x2 + t, v1 + t, v2 + t, ks + k, kd + k, l0 + t,
+                            f1x + t, f1y + t, f1z + t);
+}
+
 }  // namespace
 
 void spring_forces_of_run(Index count, Index nx, Index nv, const double* x1, const double* x2,
@@ -415,11 +438,11 @@ void FastSprings<S>::add_run(const RunView& run, Index p_begin, Index p_end, con
   for (Index c0 = first; c0 < last; c0 += kChunk) {
     const Index c1 = std::min(c0 + kChunk, last);
     const Index k = run.uniform ? 0 : c0;  // ks and kd of spring c0 (a uniform run's: of 0)
-    (run.uniform ? forces_of_run<S, true>
-                 : forces_of_run<S, false>)(c1 - c0, x.cols(), v.cols(), x.data() + run.i0 + c0,
-                                            x.data() + run.j0 + c0, v.data() + run.i0 + c0,
-                                            v.data() + run.j0 + c0, run.ks + k, run.kd + k,
-                                            run.l0 + c0, f1, f1 + kChunk, f1 + 2 * kChunk);
+    (run.uniform ? forces_in_vectors<S, true>
+                 : forces_in_vectors<S, false>)(c1 - c0, x.cols(), v.cols(), x.data() + run.i0 + c0,
+                                                x.data() + run.j0 + c0, v.data() + run.i0 + c0,
+                                                v.data() + run.j0 + c0, run.ks + k, run.kd + k,
+                                                run.l0 + c0, f1, f1 + kChunk, f1 + 2 * kChunk);
     // Springs [u0, u1) of the chunk give upper ends their shares, [l0, l1) lower ends theirs.
     // Upper end upper + t is lower end lower + t + gap: where both fall in this chunk, that
     // particle takes both at once (upper first); the others take theirs one pass at a time.
@@ -456,9 +479,45 @@ void FastSprings<S>::add_run_direct(const RunView& run, Index up_begin, Index up
                                     SoA& f) const {
   const Index lower = std::min(run.i0, run.j0), upper = std::max(run.i0, run.j0);
   const bool upper_is_j = run.j0 > run.i0;
+  const Index n = f.cols();
+  // Springs [t0, t1) of a run's last, partial vector, after the whole vectors before them: f1 of
+  // the last whole vector of springs, which ends at t1 (forces_in_vectors says why a lane's bits
+  // do not depend on the vector it is in), then the shares of springs t0 .. t1 - 1. Each of
+  // their ends takes one share of them, added to what the whole vectors left there.
+  const auto tail = [&](Index t0, Index t1, bool to_upper, bool to_lower) {
+    constexpr Index kLanes = kVectorLanes<S>;
+    S f1[3 * kLanes];
+    const Index first = t1 - kLanes, k = run.uniform ? 0 : first;
+    (run.uniform ? forces_of_run<S, true>
+                 : forces_of_run<S, false>)(kLanes, x.cols(), v.cols(), x.data() + run.i0 + first,
+                                            x.data() + run.j0 + first, v.data() + run.i0 + first,
+                                            v.data() + run.j0 + first, run.ks + k, run.kd + k,
+                                            run.l0 + first, f1, f1 + kLanes, f1 + 2 * kLanes);
+    // Fewer springs than kDirectGap: no particle is an end of two of them, so the i ends may
+    // take their shares before the j ends.
+    static_assert(kLanes <= kDirectGap);
+    const bool to_i = upper_is_j ? to_lower : to_upper, to_j = upper_is_j ? to_upper : to_lower;
+    for (Index c = 0; c < 3; ++c) {
+      const S* const share = f1 + c * kLanes;  // share[t - first]: spring t's
+      S* const fi = f.data() + c * n + run.i0;
+      S* const fj = f.data() + c * n + run.j0;
+      if (to_i) {
+        for (Index t = t0; t < t1; ++t)
+          fi[t] += share[t - first];
+      }
+      if (to_j) {
+        for (Index t = t0; t < t1; ++t)
+          fj[t] -= share[t - first];
+      }
+    }
+  };
   // Springs [t0, t1) of the run, their forces added to the ends that are in range.
   const auto springs = [&](Index t0, Index t1, bool to_upper, bool to_lower) {
     if (t0 >= t1) return;
+    // The springs past the last whole vector, if any, are finished below (tail).
+    constexpr Index kLanes = kVectorLanes<S>;
+    const Index rest = t1 - t0 > kLanes ? (t1 - t0) % kLanes : 0;
+    t1 -= rest;
     const Index k = run.uniform ? 0 : t0;  // ks and kd of spring t0 (a uniform run's: of 0)
     // run_kernel_direct<S, Uniform, UpperIsJ, ToUpper, ToLower> by
     // [uniform][upper_is_j][to_upper][to_lower].
@@ -480,6 +539,7 @@ void FastSprings<S>::add_run_direct(const RunView& run, Index up_begin, Index up
         t1 - t0, x.cols(), v.cols(), f.cols(), x.data() + run.i0 + t0, x.data() + run.j0 + t0,
         v.data() + run.i0 + t0, v.data() + run.j0 + t0, run.ks + k, run.kd + k, run.l0 + t0,
         f.data() + upper + t0, f.data() + lower + t0);
+    if (rest > 0) tail(t1, t1 + rest, to_upper, to_lower);
   };
   // Spring t has its upper end in range for t in [up_begin, up_end) and its lower end for t in
   // [lo_begin, lo_end), the same interval shifted by the gap (or clamped to the run). In the

@@ -10,6 +10,8 @@
 // hint at all.
 #pragma once
 
+#include "clothlab/core/types.hpp"
+
 #if defined(__wasm__) && !defined(__wasm_simd128__)
 #define CLOTHLAB_INDEPENDENT_ITERATIONS
 #define CLOTHLAB_INDEPENDENT_ITERATIONS_END
@@ -25,3 +27,22 @@
 #define CLOTHLAB_INDEPENDENT_ITERATIONS
 #define CLOTHLAB_INDEPENDENT_ITERATIONS_END
 #endif
+
+namespace clothlab::fast {
+
+// How many values of S one vector instruction of this build takes: 64 bytes with AVX-512, 32
+// with AVX, 16 otherwise (SSE2, WebAssembly SIMD). A loop whose count is not a multiple of it
+// leaves a remainder that the compiler finishes with narrower vectors and then one value at a
+// time; springs.cpp finishes a run's instead with one more full vector (forces_of_run's
+// callers there say how, and why the bits are the same).
+#if defined(__AVX512F__)
+inline constexpr Index kVectorBytes = 64;
+#elif defined(__AVX__)
+inline constexpr Index kVectorBytes = 32;
+#else
+inline constexpr Index kVectorBytes = 16;
+#endif
+template <class S>
+inline constexpr Index kVectorLanes = kVectorBytes / static_cast<Index>(sizeof(S));
+
+}  // namespace clothlab::fast
