@@ -13,6 +13,7 @@
 #include <string>
 
 #include "io/npy.hpp"
+#include "scratch_dir.hpp"
 
 namespace fs = std::filesystem;
 using clothlab::Matrix3X;
@@ -26,10 +27,7 @@ std::string read_bytes(const fs::path& file) {
 }
 
 fs::path fresh_file(const std::string& name) {
-  const fs::path dir = fs::temp_directory_path() / "clothlab-test-npy";
-  fs::create_directories(dir);
-  fs::remove(dir / name);
-  return dir / name;
+  return test::scratch_path(name);
 }
 
 // The dictionary in a header: the text after the 10 bytes of magic, version and length.

@@ -25,6 +25,7 @@
 #include "io/run.hpp"
 #include "io/run_folder.hpp"
 #include "scene/scene.hpp"
+#include "scratch_dir.hpp"
 
 namespace fs = std::filesystem;
 using clothlab::OutputError;
@@ -32,9 +33,7 @@ using clothlab::OutputError;
 namespace {
 
 fs::path fresh_dir(const std::string& name) {
-  const fs::path dir = fs::temp_directory_path() / ("clothlab-outputs-" + name);
-  fs::remove_all(dir);
-  return dir;
+  return test::scratch_path(name);
 }
 
 std::string read_all(const fs::path& file) {

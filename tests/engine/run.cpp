@@ -16,6 +16,7 @@
 #include "clothlab/core/kernel_answer.hpp"
 #include "io/run.hpp"
 #include "scene/scene.hpp"
+#include "scratch_dir.hpp"
 
 namespace fs = std::filesystem;
 
@@ -57,9 +58,7 @@ max_position = 1.0
 }
 
 fs::path fresh_dir(const std::string& name) {
-  const fs::path dir = fs::temp_directory_path() / ("clothlab-test-" + name);
-  fs::remove_all(dir);
-  return dir;
+  return test::scratch_path(name);
 }
 
 }  // namespace

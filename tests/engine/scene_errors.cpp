@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "scene/scene.hpp"
+#include "scratch_dir.hpp"
 
 namespace fs = std::filesystem;
 
@@ -586,7 +587,7 @@ TEST_CASE("scene error: a particle on two long pin paths is found without compar
 }
 
 TEST_CASE("scene error: a directory, a device and a huge file are refused before reading") {
-  const fs::path dir = fs::temp_directory_path() / "clothlab-scene-inputs";
+  const fs::path dir = test::scratch_path("scene-inputs");
   fs::create_directories(dir);
   CHECK_THROWS_WITH_AS(
       (void)clothlab::load_scene_file(dir),

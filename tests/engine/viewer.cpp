@@ -17,6 +17,7 @@
 
 #include "clothlab/core/world.hpp"
 #include "io/viewer.hpp"
+#include "scratch_dir.hpp"
 
 namespace fs = std::filesystem;
 using clothlab::ViewerRecorder;
@@ -43,8 +44,7 @@ void offer_frames(ViewerRecorder& viewer, World& world, int count) {
 }
 
 fs::path fresh_dir(const std::string& name) {
-  const fs::path dir = fs::temp_directory_path() / ("clothlab-test-viewer-" + name);
-  fs::remove_all(dir);
+  const fs::path dir = test::scratch_path(name);
   fs::create_directories(dir);
   return dir;
 }
