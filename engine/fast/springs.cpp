@@ -204,14 +204,15 @@ template <class S, bool Uniform>
 // a time) the remainder is one spring at most, which one more vector and a call could only cost
 // more than: there the compiler's remainder stays. (In the page, the two measured alike within
 // their spread: SPEED.md.)
-constexpr Index kNarrowLanes = 2;
+template <class S>
+constexpr bool kWholeVectorEnds = kVectorLanes<S> > 2;
 template <class S, bool Uniform>
 void forces_in_vectors(Index count, Index nx, Index nv, const S* x1, const S* x2, const S* v1,
                        const S* v2, const double* ks, const double* kd, const double* l0, S* f1x,
                        S* f1y, S* f1z) {
   constexpr Index kLanes = kVectorLanes<S>;
   const Index whole = count - count % kLanes;
-  if (kLanes <= kNarrowLanes || whole == count || whole == 0) {
+  if (!kWholeVectorEnds<S> || whole == count || whole == 0) {
     forces_of_run<S, Uniform>(count, nx, nv, x1, x2, v1, v2, ks, kd, l0, f1x, f1y, f1z);
     return;
   }
@@ -522,7 +523,7 @@ void FastSprings<S>::add_run_direct(const RunView& run, Index up_begin, Index up
     if (t0 >= t1) return;
     // The springs past the last whole vector, if any, are finished below (tail).
     constexpr Index kLanes = kVectorLanes<S>;
-    const Index rest = kLanes > kNarrowLanes && t1 - t0 > kLanes ? (t1 - t0) % kLanes : 0;
+    const Index rest = kWholeVectorEnds<S> && t1 - t0 > kLanes ? (t1 - t0) % kLanes : 0;
     t1 -= rest;
     const Index k = run.uniform ? 0 : t0;  // ks and kd of spring t0 (a uniform run's: of 0)
     // run_kernel_direct<S, Uniform, UpperIsJ, ToUpper, ToLower> by

@@ -33,8 +33,8 @@ namespace clothlab::fast {
 // How many values of S one vector instruction of this build takes: 64 bytes with AVX-512, 32
 // with AVX, 16 otherwise (SSE2, WebAssembly SIMD). A loop whose count is not a multiple of it
 // leaves a remainder that the compiler finishes with narrower vectors and then one value at a
-// time; springs.cpp finishes a run's instead with one more full vector (forces_of_run's
-// callers there say how, and why the bits are the same).
+// time; where a vector holds more than two values, springs.cpp finishes a run's instead with
+// one more full vector (forces_of_run's callers there say how, and why the bits are the same).
 #if defined(__AVX512F__)
 inline constexpr Index kVectorBytes = 64;
 #elif defined(__AVX__)

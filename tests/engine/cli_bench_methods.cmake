@@ -3,8 +3,8 @@
 # itself at half its step is below every stable method's error (the reference has converged), and
 # symplectic Euler's error falls as its step falls; the plot script is written, and the plot drawn
 # when matplotlib is there. Its timings are never checked. Then `--speed` on a small grid writes
-# its CSV, with VBD's rows, readable and engine room (numbers, of either sign), and prints the measured
-# bound on an XPBD iteration and on two threads.
+# its CSV, with VBD's rows, readable and engine room (numbers, of either sign), and prints the
+# measured bound on an XPBD iteration and on two threads.
 cmake_policy(VERSION 3.22)  # quoted strings are strings, never variables' names (CMP0054)
 include(${CMAKE_CURRENT_LIST_DIR}/cli_bench_checks.cmake)
 file(REMOVE_RECURSE ${WORK})
@@ -45,8 +45,8 @@ foreach(scene bakeoff-hanging-sheet bakeoff-gusty-flag bakeoff-drape)
   endif()
   foreach(error IN LISTS errors)
     if(NOT self_difference LESS error)
-      message(FATAL_ERROR "${scene}: the reference differs from itself by ${self_difference}, not less "
-                          "than a method's error ${error}: it has not converged\n${out}")
+      message(FATAL_ERROR "${scene}: the reference differs from itself by ${self_difference}, "
+                          "not less than a method's error ${error}: it has not converged\n${out}")
     endif()
   endforeach()
   list(LENGTH euler count)

@@ -26,10 +26,6 @@ std::string read_bytes(const fs::path& file) {
   return std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
 }
 
-fs::path fresh_file(const std::string& name) {
-  return test::scratch_path(name);
-}
-
 // The dictionary in a header: the text after the 10 bytes of magic, version and length.
 std::string dictionary(const std::string& bytes) {
   return bytes.substr(10, NpyFrameWriter::kHeaderBytes - 10);
@@ -50,7 +46,7 @@ Matrix3X frame(int f, int n) {
 }  // namespace
 
 TEST_CASE("npy: the header is version 1.0 with the data at 128 bytes, a multiple of 64") {
-  const fs::path file = fresh_file("empty.npy");
+  const fs::path file = test::scratch_path("empty.npy");
   const NpyFrameWriter writer(file, 5);
   const std::string bytes = read_bytes(file);
   REQUIRE(bytes.size() == 128);
@@ -71,7 +67,7 @@ TEST_CASE("npy: the header is version 1.0 with the data at 128 bytes, a multiple
 
 TEST_CASE("npy: each frame appended is counted in the header, its values the doubles rounded") {
   const int n = 4;
-  const fs::path file = fresh_file("frames.npy");
+  const fs::path file = test::scratch_path("frames.npy");
   NpyFrameWriter writer(file, n);
   const size_t frame_bytes = 3 * n * sizeof(float);  // 12 bytes a particle
   for (int f = 0; f < 3; ++f) {
@@ -118,7 +114,7 @@ TEST_CASE("npy: a write that fails names the file and the reason and leaves the 
     // limit is lifted again, so that the test's own output cannot meet it.
     const int n = 1000;
     const long frame_bytes = 3 * n * sizeof(float);
-    const fs::path file = fresh_file("limited.npy");
+    const fs::path file = test::scratch_path("limited.npy");
     NpyFrameWriter writer(file, n);
     rlimit before{};
     REQUIRE(getrlimit(RLIMIT_FSIZE, &before) == 0);

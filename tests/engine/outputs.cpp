@@ -32,10 +32,6 @@ using clothlab::OutputError;
 
 namespace {
 
-fs::path fresh_dir(const std::string& name) {
-  return test::scratch_path(name);
-}
-
 std::string read_all(const fs::path& file) {
   std::ifstream in(file, std::ios::binary);
   return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
@@ -97,7 +93,7 @@ class FileSizeLimit {
 }  // namespace
 
 TEST_CASE("outputs: a piece a full disk takes only part of is cut off again") {
-  const fs::path dir = fresh_dir("append");
+  const fs::path dir = test::scratch_path("append");
   fs::create_directories(dir);
   clothlab::AppendFile file(dir / "rows.csv");
   file.append("header\n");
@@ -127,7 +123,7 @@ TEST_CASE("outputs: a full device is an error that names the file and says why")
 }
 
 TEST_CASE("outputs: a replaced file is the old one or the new one, never a part") {
-  const fs::path dir = fresh_dir("replace");
+  const fs::path dir = test::scratch_path("replace");
   fs::create_directories(dir);
   write_text(dir / "page.html", "old page");
   {
@@ -152,7 +148,7 @@ TEST_CASE("outputs: a replaced file is the old one or the new one, never a part"
 }
 
 TEST_CASE("outputs: a run folder is refused if it is the user's, unless forced") {
-  const fs::path dir = fresh_dir("foreign");
+  const fs::path dir = test::scratch_path("foreign");
   fs::create_directories(dir / "data");
   write_text(dir / "positions.csv", "my own measurements\n");
   write_text(dir / "notes.txt", "keep me\n");
@@ -187,7 +183,7 @@ TEST_CASE("outputs: a run folder is refused if it is the user's, unless forced")
 }
 
 TEST_CASE("outputs: two runs into one folder at once: the second is refused") {
-  const fs::path dir = fresh_dir("lock");
+  const fs::path dir = test::scratch_path("lock");
   {
     clothlab::RunFolder first(dir, false);
     CHECK_THROWS_WITH_AS(clothlab::RunFolder(dir, false),
@@ -202,7 +198,7 @@ TEST_CASE("outputs: two runs into one folder at once: the second is refused") {
 }
 
 TEST_CASE("outputs: --html over a file that is not a viewer page is refused unless forced") {
-  const fs::path dir = fresh_dir("page");
+  const fs::path dir = test::scratch_path("page");
   fs::create_directories(dir);
   write_text(dir / "report.html", "<html>my report</html>");
   CHECK_THROWS_WITH_AS(
@@ -231,7 +227,7 @@ TEST_CASE("outputs: --html over a file that is not a viewer page is refused unle
 
 TEST_CASE("outputs: --out with a trailing slash or a ./ is the same folder as without") {
   for (const std::string spelling : {"/", "/./", "/.//"}) {
-    const fs::path dir = fresh_dir("slash");
+    const fs::path dir = test::scratch_path("slash");
     clothlab::Scene scene = clothlab::parse_scene(kCloth, "<cloth>");
     const clothlab::RunReport report = clothlab::run_scene(scene, dir.string() + spelling);
     CHECK(report.frames == 21);
@@ -240,7 +236,7 @@ TEST_CASE("outputs: --out with a trailing slash or a ./ is the same folder as wi
 }
 
 TEST_CASE("outputs: a second run clears the first run's frames and leaves the user's files") {
-  const fs::path dir = fresh_dir("rerun");
+  const fs::path dir = test::scratch_path("rerun");
   {
     clothlab::Scene scene = clothlab::parse_scene(kCloth, "<cloth>");
     clothlab::RunOutputs outputs = clothlab::RunOutputs::in(dir);
@@ -268,7 +264,7 @@ TEST_CASE("outputs: a second run clears the first run's frames and leaves the us
 }
 
 TEST_CASE("outputs: a run stopped by a signal ends with a whole last frame and its page") {
-  const fs::path dir = fresh_dir("signal");
+  const fs::path dir = test::scratch_path("signal");
   clothlab::Scene scene = clothlab::parse_scene(kCloth, "<cloth>");
   // A TERM arrives after step 37, between frames (frames are every 10 steps).
   const auto progress = [](long done, long) {
@@ -303,7 +299,7 @@ TEST_CASE("outputs: a run stopped by a signal ends with a whole last frame and i
 }
 
 TEST_CASE("outputs: a frame with a value too large for a double is refused, not written") {
-  const fs::path dir = fresh_dir("overflow");
+  const fs::path dir = test::scratch_path("overflow");
   // The guard's bounds, widened, let a speed through whose kinetic energy 1/2 m v^2 is inf
   // (v > 1.9e154 m/s): after step 1 of a fall in a gravity of 1e300 m/s^2.
   std::string text = R"(
@@ -353,7 +349,7 @@ fps = 100
 }
 
 TEST_CASE("outputs: format npy writes positions.npy in place of positions.csv, frame for frame") {
-  const fs::path dir = fresh_dir("npy");
+  const fs::path dir = test::scratch_path("npy");
   std::string text = kCloth;
   text += "velocities = true\nformat = \"npy\"\n";  // in [output], the last table
   clothlab::Scene scene = clothlab::parse_scene(text, "<cloth>");
@@ -377,7 +373,7 @@ namespace {
 
 // A folder of files a run must never touch, each holding "victim NAME\n".
 fs::path make_victims(const std::string& test, const std::vector<std::string>& names) {
-  const fs::path victims = fresh_dir(test + "-victims");
+  const fs::path victims = test::scratch_path(test + "-victims");
   fs::create_directories(victims);
   for (const std::string& name : names)
     write_text(victims / name, "victim " + name + "\n");
@@ -393,7 +389,7 @@ void check_victims(const fs::path& victims, const std::vector<std::string>& name
 }  // namespace
 
 TEST_CASE("outputs: every writer replaces a symbolic link in its place and not the file it names") {
-  const fs::path dir = fresh_dir("writer-links");
+  const fs::path dir = test::scratch_path("writer-links");
   fs::create_directories(dir);
   const std::vector<std::string> names = {"append", "npy", "partial", "replace"};
   const fs::path victims = make_victims("writer-links", names);
@@ -420,7 +416,7 @@ TEST_CASE("outputs: every writer replaces a symbolic link in its place and not t
 TEST_CASE("outputs: a marker that is a link or has a second name is refused and its file kept") {
   const std::vector<std::string> names = {"marker"};
   const fs::path victims = make_victims("marker-link", names);
-  const fs::path dir = fresh_dir("marker-link");
+  const fs::path dir = test::scratch_path("marker-link");
   fs::create_directories(dir);
   fs::create_symlink(victims / "marker", dir / ".clothlab-run");
   for (const bool force : {false, true}) {
@@ -459,7 +455,7 @@ TEST_CASE("outputs: a marker that is a link or has a second name is refused and 
 }
 
 TEST_CASE("outputs: links in a run folder are removed as names and what they point to is kept") {
-  const fs::path dir = fresh_dir("folder-links");
+  const fs::path dir = test::scratch_path("folder-links");
   const auto run = [&](bool npy) {
     std::string text = kCloth;
     text += npy ? "velocities = true\nformat = \"npy\"\n" : "velocities = true\nsprings = true\n";
@@ -503,7 +499,7 @@ TEST_CASE("outputs: links in a run folder are removed as names and what they poi
 
 TEST_CASE(
     "outputs: --html is no link nor a note that mentions the viewer nor another run's folder") {
-  const fs::path dir = fresh_dir("html-place");
+  const fs::path dir = test::scratch_path("html-place");
   fs::create_directories(dir);
   const std::vector<std::string> names = {"page"};
   const fs::path victims = make_victims("html-place", names);
@@ -555,7 +551,7 @@ TEST_CASE("outputs: an fps so small that 1 / (fps dt) overflows writes the first
   std::string text = kCloth;
   text.replace(text.find("fps = 100"), 9, "fps = 1e-300");
   clothlab::Scene scene = clothlab::parse_scene(text, "<cloth>");
-  const clothlab::RunReport report = clothlab::run_scene(scene, fresh_dir("tiny-fps"));
+  const clothlab::RunReport report = clothlab::run_scene(scene, test::scratch_path("tiny-fps"));
   CHECK(report.steps == 200);
   CHECK(report.frames == 2);
 }
@@ -578,7 +574,7 @@ duration = 0.1
 [output]
 fps = 100
 )";
-  const fs::path dir = fresh_dir("float-range");
+  const fs::path dir = test::scratch_path("float-range");
   clothlab::Scene scene = clothlab::parse_scene(text, "<fast>");
   CHECK_THROWS_WITH_AS(clothlab::run_scene(scene, dir),
                        "frame 4 (after step 4, t = 0.04 s) would write a position [m] of 4e+38: "
@@ -637,7 +633,7 @@ TEST_CASE("outputs: a TERM during a step of many substeps gives it up at once") 
   auto stopper = std::make_unique<StopAtEvaluation>(2 * 2000 + 5);
   const StopAtEvaluation& counter = *stopper;
   scene.world.force_effects.push_back(std::move(stopper));
-  const fs::path dir = fresh_dir("term-substeps");
+  const fs::path dir = test::scratch_path("term-substeps");
   try {
     clothlab::run_scene(scene, dir);
     FAIL("the run was not stopped");
@@ -673,7 +669,7 @@ TEST_CASE("outputs: the long loops give up their work on a stop only where a run
 }
 
 TEST_CASE("outputs: after a SIGKILL every file is cut back to the frames all of them hold") {
-  const fs::path dir = fresh_dir("killed");
+  const fs::path dir = test::scratch_path("killed");
   for (const bool npy : {false, true}) {
     CAPTURE(npy);
     std::string text = kCloth;

@@ -57,10 +57,6 @@ max_position = 1.0
                                "falls-out.toml");
 }
 
-fs::path fresh_dir(const std::string& name) {
-  return test::scratch_path(name);
-}
-
 }  // namespace
 
 TEST_CASE("run: a scene writes one energy row and one position row per particle per frame") {
@@ -80,7 +76,7 @@ duration = 1
 fps = 10
 )",
                                                 "two.toml");
-  const fs::path dir = fresh_dir("frames");
+  const fs::path dir = test::scratch_path("frames");
   const clothlab::RunReport report = clothlab::run_scene(scene, dir);
   CHECK(report.steps == 100);
   CHECK(report.frames == 11);  // t = 0, 0.1, ..., 1.0: a frame every 10 steps, and frame 0
@@ -104,7 +100,7 @@ fps = 10
 TEST_CASE("run: when the guard stops a run the files hold every frame before it") {
   clothlab::Scene scene = falls_out();
   // Free fall passes 1 m after sqrt(2 / 9.8) = 0.45 s, at about step 45.
-  const fs::path dir = fresh_dir("guard");
+  const fs::path dir = test::scratch_path("guard");
   long failed_step = -1;
   try {
     clothlab::run_scene(scene, dir);
@@ -139,7 +135,7 @@ duration = 0.01
 fps = 500
 )",
                                                 "small.toml");
-  const fs::path dir = fresh_dir("meshes");
+  const fs::path dir = test::scratch_path("meshes");
   clothlab::RunOutputs outputs = clothlab::RunOutputs::in(dir);
   outputs.obj = outputs.vtk = true;
   const clothlab::RunReport report = clothlab::run_scene(scene, outputs);
@@ -188,7 +184,7 @@ duration = 1
 fps = 10
 )",
                                                 "page.toml");
-  const fs::path dir = fresh_dir("page");
+  const fs::path dir = test::scratch_path("page");
   clothlab::run_scene(scene, dir);
   std::ifstream in(dir / "view.html");
   const std::string page((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
@@ -242,7 +238,7 @@ velocities = true
 springs = true
 )",
                                                 "hanging.toml");
-  const fs::path dir = fresh_dir("physicist");
+  const fs::path dir = test::scratch_path("physicist");
   const clothlab::RunReport report = clothlab::run_scene(scene, dir);
   REQUIRE(report.frames == 6);
   CHECK(std::count(report.files.begin(), report.files.end(), dir / "springs.csv") == 1);
@@ -287,7 +283,7 @@ dt = 0.1
 duration = 0.2
 )",
                                                 "plain.toml");
-  const fs::path plain_dir = fresh_dir("plain");
+  const fs::path plain_dir = test::scratch_path("plain");
   clothlab::run_scene(plain, plain_dir);
   CHECK(!fs::exists(plain_dir / "velocities.csv"));
   CHECK(!fs::exists(plain_dir / "springs.csv"));
@@ -310,7 +306,7 @@ TEST_CASE("run: a run stops at the step of a bad answer, with the frames before 
   // An exercise's answer the engine cannot use (clothlab/core/kernel_answer.hpp), at step 3.
   clothlab::Scene scene = falls_out();
   scene.world.post_step_effects.push_back(std::make_unique<BadAnswerAtStep3>());
-  const fs::path dir = fresh_dir("kernel-answer");
+  const fs::path dir = test::scratch_path("kernel-answer");
   const clothlab::RunOutputs outputs = clothlab::RunOutputs::in(dir);
   long step = -1;
   std::string message;
