@@ -21,6 +21,10 @@ void add_bench_roofline_command(CLI::App& bench);  // bench_roofline.cpp
 // `min_seconds` each.
 std::string speed_cloth_scene(int n, int threads);
 double reference_ns_per_spring_step(int n, int repeats, double min_seconds);
+// `bench speed`'s `kernel` row, timed the same way: the fast path's spring loop alone over the
+// first 256 springs of a row of its 32 x 32 cloth, whose data stay in the first-level cache (no
+// copies, no guard, no move); ns per spring.
+double kernel_ns_per_spring(int repeats, double min_seconds);
 // The option `--sizes N,N,...` of the commands that time bench speed's cloths.
 void add_cloth_sizes_option(CLI::App& command, std::vector<int>& sizes);
 

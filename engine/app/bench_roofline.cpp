@@ -551,6 +551,7 @@ int bench_roofline(RooflineOptions opt) {
     row.bandwidth_ns = row.bytes.moved / row.copy_gbs / static_cast<double>(row.bytes.springs);
     row.engine_ns = reference_ns_per_spring_step(row.n, opt.repeats, opt.min_seconds);
   }
+  const double kernel_ns = kernel_ns_per_spring(opt.repeats, opt.min_seconds);
 
   fmt::print(
       "  the floor of a step, per spring: compute = a square root then a division (double, "
@@ -558,18 +559,27 @@ int bench_roofline(RooflineOptions opt) {
       "bytes as it touches; floor = the larger.\n  engine: bench speed's reference, 1 thread, "
       "median of {} repeats of at least {} s.\n",
       opt.repeats, opt.min_seconds);
-  fmt::print("  {:>4} {:>8} {:>8} {:>9} {:>9} {:>10} {:>10} {:>8}  {:<9} {:>9} {:>12}\n", "N",
-             "springs", "data MB", "B/spring", "copy GB/s", "compute ns", "bandwidth", "floor ns",
-             "bound by", "engine ns", "engine/floor");
+  fmt::print("  {:>4} {:>8} {:>8} {:>9} {:>9} {:>10} {:>10} {:>8}  {:<9} {:>9} {:>12} {:>13}\n",
+             "N", "springs", "data MB", "B/spring", "copy GB/s", "compute ns", "bandwidth",
+             "floor ns", "bound by", "engine ns", "engine/floor", "engine/kernel");
   for (const Row& r : rows) {
     fmt::print(
         "  {:>4} {:>8} {:>8.2f} {:>9.1f} {:>9.2f} {:>10.3f} {:>10.3f} {:>8.3f}  {:<9} {:>9.3f} "
-        "{:>12.2f}\n",
+        "{:>12.2f} {:>13.2f}\n",
         r.n, r.bytes.springs, r.bytes.touched * 1e-6,
         r.bytes.moved / static_cast<double>(r.bytes.springs), r.copy_gbs, r.compute_ns,
         r.bandwidth_ns, r.floor_ns(), r.compute_ns >= r.bandwidth_ns ? "compute" : "bandwidth",
-        r.engine_ns, r.engine_ns / r.floor_ns());
+        r.engine_ns, r.engine_ns / r.floor_ns(), r.engine_ns / kernel_ns);
   }
+  // The kernel against the compute floor: how much of a spring's own arithmetic the floor's
+  // square root and division are. Where the divider is fast, the rest of the kernel's work (its
+  // other operations, loads and stores) sets its pace, and no arrangement of the step that keeps
+  // the kernel's operations can come near the floor.
+  fmt::print(
+      "  kernel: the spring loop alone (bench speed's kernel row: 256 springs in the first-level "
+      "cache, no copies,\n  no guard, no move), median of {} repeats: {:.3f} ns per spring, {:.2f} "
+      "times the compute floor.\n",
+      opt.repeats, kernel_ns, kernel_ns / a.pair_d.per_lane);
 
   // Threads: 1 against 2, what two lose of 2, and the model for 8 and 16 cores.
   std::vector<ThreadsRow> threads;
@@ -632,7 +642,7 @@ int bench_roofline(RooflineOptions opt) {
         "n,particles,springs,data_bytes,bytes_per_spring,copy_gb_per_s,compute_floor_ns,"
         "bandwidth_floor_ns,floor_ns,engine_ns,engine_over_floor,engine_1_thread_ns,"
         "engine_2_threads_ns,speedup_2,lost_serial,lost_energy_check,lost_wake,lost_imbalance,"
-        "lost_work,model_2_ns,model_8_ns,model_16_ns\n";
+        "lost_work,model_2_ns,model_8_ns,model_16_ns,kernel_ns,engine_over_kernel\n";
     for (size_t k = 0; k < rows.size(); ++k) {
       const Row& r = rows[k];
       const ThreadsRow& t = threads[k];
@@ -641,13 +651,14 @@ int bench_roofline(RooflineOptions opt) {
       fmt::format_to(std::back_inserter(table),
                      "{},{},{},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},"
                      "{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},"
-                     "{:.6g}\n",
+                     "{:.6g},{:.6g},{:.6g}\n",
                      r.n, r.bytes.particles, r.bytes.springs, r.bytes.touched,
                      r.bytes.moved / static_cast<double>(r.bytes.springs), r.copy_gbs, r.compute_ns,
                      r.bandwidth_ns, r.floor_ns(), r.engine_ns, r.engine_ns / r.floor_ns(),
                      ns * t.one.step, ns * t.two.step, t.speedup(), t.lost_serial(),
                      t.lost_energy_check(), t.lost_wake(), t.lost_imbalance(), t.lost_work(),
-                     ns * model.step(2), ns * model.step(8), ns * model.step(16));
+                     ns * model.step(2), ns * model.step(8), ns * model.step(16), kernel_ns,
+                     r.engine_ns / kernel_ns);
     }
     write_whole_file(csv, table);
     fmt::print("\n  wrote {}\n", csv.string());

@@ -1,7 +1,8 @@
 # `clothlab bench roofline --quick --csv F`: the machine's limits are printed as positive figures;
 # the CSV has the documented header and a row per cloth size whose numbers are positive and
-# finite; each floor is the larger of its compute and bandwidth floors; and the engine's step is
-# no faster than its floor. The threads' part is there: the copy on 2 threads, a row per size of
+# finite; each floor is the larger of its compute and bandwidth floors; the engine's step is no
+# faster than its floor, and the spring loop alone (bench speed's kernel row) no faster than the
+# compute floor. The threads' part is there: the copy on 2 threads, a row per size of
 # the 1 and 2 thread steps with what two threads lose and to what, and of the model of 8 and 16
 # cores, which says its socket bandwidth is assumed. No timing is asserted by value.
 #
@@ -50,7 +51,7 @@ include(${CMAKE_CURRENT_LIST_DIR}/bench_csv.cmake)
 string(CONCAT header "n,particles,springs,data_bytes,bytes_per_spring,copy_gb_per_s,"
        "compute_floor_ns,bandwidth_floor_ns,floor_ns,engine_ns,engine_over_floor,"
        "engine_1_thread_ns,engine_2_threads_ns,speedup_2,lost_serial,lost_energy_check,lost_wake,"
-       "lost_imbalance,lost_work,model_2_ns,model_8_ns,model_16_ns")
+       "lost_imbalance,lost_work,model_2_ns,model_8_ns,model_16_ns,kernel_ns,engine_over_kernel")
 # What two threads lose of a speed-up of 2 are differences of measurements: the serial part, the
 # wake and the slower work may come out below 0 by noise (two halves of a small cloth can each
 # fit a cache the whole does not), so they are finite, of either sign. Every time is positive.
@@ -64,7 +65,14 @@ foreach(line ${lines})
   list(GET fields 8 floor)
   list(GET fields 9 engine)
   list(GET fields 10 ratio)
+  list(GET fields 22 kernel)
   list(APPEND sizes ${n})
+  # The spring loop alone does every spring's square root and division too, at the vector width
+  # the floor's loop has, and more besides: it cannot beat the compute floor either.
+  if(kernel LESS compute)
+    message(FATAL_ERROR "n = ${n}: the spring loop alone (${kernel} ns per spring) beat the "
+                        "compute floor (${compute} ns)\n${out}")
+  endif()
   # The floor is the larger of the two: the same number, so the same digits in the CSV.
   set(larger ${compute})
   if(bandwidth GREATER compute)
@@ -79,7 +87,7 @@ foreach(line ${lines})
                         "ns): engine/floor = ${ratio}\n${out}")
   endif()
   # The table prints the same row: N, springs, ..., and the ratio at its end.
-  if(NOT out MATCHES "\n +${n} +[0-9]+ [^\n]*(compute|bandwidth) +${number} +${number}\n")
+  if(NOT out MATCHES "\n +${n} +[0-9]+ [^\n]*(compute|bandwidth) +${number} +${number} +${number}\n")
     message(FATAL_ERROR "no table row for N = ${n}:\n${out}")
   endif()
 endforeach()
@@ -94,7 +102,8 @@ foreach(n ${sizes})
     message(FATAL_ERROR "no row of the model of 8 and 16 cores for N = ${n}:\n${out}")
   endif()
 endforeach()
-foreach(phrase "ASSUMED, not measured" "peak memory of this run [0-9]+ MB")
+foreach(phrase "ASSUMED, not measured" "peak memory of this run [0-9]+ MB"
+               "kernel: the spring loop alone [^\n]*\n[^\n]*: [0-9.]+ ns per spring, [0-9.]+ times the compute floor")
   if(NOT out MATCHES "${phrase}")
     message(FATAL_ERROR "the printout does not say '${phrase}':\n${out}")
   endif()
