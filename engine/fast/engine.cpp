@@ -114,6 +114,20 @@ bool FastEngine::sum_forces(const World& world, const Matrix3X& x, const Matrix3
   return true;
 }
 
+bool FastEngine::potential_energy(const World& world, const ForceEffect& effect, const Matrix3X& x,
+                                  double& energy) {
+  // The effect's place in the world's list, and its fast form there (made if not yet).
+  const auto& effects = world.force_effects;
+  forces_.resize(effects.size());
+  for (size_t e = 0; e < effects.size(); ++e) {
+    if (effects[e].get() != &effect) continue;
+    Force& force = forces_[e];
+    force.match(effect, fast_force);
+    return force.fast && force.fast->potential_energy(world.particles, x, energy);
+  }
+  return false;
+}
+
 BackendStep FastEngine::step(World& world, double dt) {
   if (precision == Precision::float32) {
     if (!float_room_) float_room_ = std::make_shared<FloatRoom>();

@@ -113,6 +113,8 @@ class FastEngine final : public Backend {
 
   bool sum_forces(const World& world, const Matrix3X& x, const Matrix3X& v, Matrix3X& f) override;
   BackendStep step(World& world, double dt) override;
+  bool potential_energy(const World& world, const ForceEffect& effect, const Matrix3X& x,
+                        double& energy) override;
   bool xpbd_project(World& world, const XpbdConstraints& constraints, const Matrix3X& x_old,
                     double h, int iterations, bool keep_lambda,
                     std::vector<double>& lambda) override;

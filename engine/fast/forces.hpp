@@ -40,6 +40,12 @@ class FastForceOf {
   // Springs it takes through grid stencils (springs.hpp), as prepared last: for tests and the
   // bench.
   virtual size_t stencil_springs() const { return 0; }
+
+  // The effect's potential energy at x (the engine's layout), as its own potential_energy
+  // computes it, bit for bit (Backend::potential_energy). False: declined.
+  virtual bool potential_energy(const Particles& /*p*/, const Matrix3X& /*x*/, double& /*energy*/) {
+    return false;
+  }
 };
 using FastForce = FastForceOf<double>;
 

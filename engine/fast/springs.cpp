@@ -222,6 +222,22 @@ void forces_in_vectors(Index count, Index nx, Index nv, const S* x1, const S* x2
                             f1x + t, f1y + t, f1z + t);
 }
 
+// The energies of springs t = 0 .. count - 1 of a run, the exercise's spring_energy of each (its
+// ends x1 + 3 t and x2 + 3 t in the engine's layout, x, y, z side by side), into e[t]. A loop
+// of its own, with pointers declared not to overlap and the kernel inlined (`flatten`), so that
+// the compiler takes several springs an instruction, square roots included; each lane does the
+// operations a spring alone would, so each energy has the same bits.
+[[gnu::noinline, gnu::flatten]] void energies_of_run(Index count, const double* __restrict x1,
+                                                     const double* __restrict x2,
+                                                     const double* __restrict ks,
+                                                     const double* __restrict l0,
+                                                     double* __restrict e) {
+  for (Index t = 0; t < count; ++t) {
+    e[t] = spring_energy(Vec3(x1[3 * t], x1[3 * t + 1], x1[3 * t + 2]),
+                         Vec3(x2[3 * t], x2[3 * t + 1], x2[3 * t + 2]), ks[t], l0[t]);
+  }
+}
+
 }  // namespace
 
 void spring_forces_of_run(Index count, Index nx, Index nv, const double* x1, const double* x2,
@@ -381,6 +397,29 @@ class FastSprings final : public FastForceOf<S> {
 
   size_t stencil_springs() const override { return layout_.stencil_springs(); }
 
+  // The springs' energy as SpringDampers::potential_energy sums it: each spring's energy in
+  // the set's order, added one after the other. The energies come run by run, several springs
+  // an instruction (energies_of_run), into energies_; the sum then reads them in order, so the
+  // bits are the same. On doubles only: the energies the guard checks are the engine's.
+  bool potential_energy(const Particles& p, const Matrix3X& x, double& energy) override {
+    if constexpr (!std::is_same_v<S, double>) {
+      return false;
+    } else {
+      if (!prepare(p)) return false;  // runs too short to pay: the effect's own loop
+      const SpringSet& s = springs_.springs();
+      energies_.resize(s.size());
+      for (const SpringRun& run : runs_) {
+        energies_of_run(run.length, x.data() + 3 * run.i0, x.data() + 3 * run.j0,
+                        s.ks().data() + run.k0, s.l0().data() + run.k0, energies_.data() + run.k0);
+      }
+      double sum = 0.0;
+      for (const double e : energies_)
+        sum += e;
+      energy = sum;
+      return true;
+    }
+  }
+
  private:
   RunView view(const SpringRun& run) const {
     const SpringSet& s = springs_.springs();
@@ -422,6 +461,7 @@ class FastSprings final : public FastForceOf<S> {
   SpringLayout layout_;          // and as the fast path takes them
   bool built_ = false;
   unsigned long version_ = 0, rest_version_ = 0;
+  std::vector<double> energies_;  // potential_energy's, one a spring in the set's order
 };
 
 template <class S>

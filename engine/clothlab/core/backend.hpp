@@ -18,6 +18,7 @@
 namespace clothlab {
 
 class World;
+class ForceEffect;
 struct XpbdConstraints;
 struct LinearSolveStats;
 struct LocalGlobalSystem;
@@ -46,6 +47,13 @@ class Backend {
 
   // Takes as much of one step of dt [s] as it can (see BackendStep); {} declines it all.
   virtual BackendStep step(World& world, double dt) = 0;
+  // The potential energy of `effect`, one of world's force effects, at x, as
+  // effect.potential_energy(world.particles, x) computes it, bit for bit. False: declined, and
+  // `energy` is untouched.
+  virtual bool potential_energy(const World& /*world*/, const ForceEffect& /*effect*/,
+                                const Matrix3X& /*x*/, double& /*energy*/) {
+    return false;
+  }
 
   // XPBD's projections of one substep of h [s] (integrators/xpbd.hpp): `iterations` times,
   // every constraint of `constraints` in its order, on world.particles.x, the substep having
