@@ -264,7 +264,7 @@ NaiveCloth naive_cloth(const World& world, int n) {
 // The arrays share one allocation, laid out so that the loop never loads from the same place
 // within a 4 KiB page as one of its stores a few springs before: a processor takes such a load
 // for one that may read what the store writes and holds it until the store's address is known
-// in full ("4K aliasing"). With each array where the heap put it, the row measured 0.77 to 1.3
+// in full ("4K aliasing"). With each array where the heap put it, the row measured 0.76 to 1.3
 // ns per spring on one Zen 5 machine from one run to the next, as the heap's addresses fell.
 struct KernelRun {
   static constexpr long kPasses = 16;  // evaluations of the run per timed "step"
