@@ -2,7 +2,9 @@
 //
 // Aerodynamics::add_forces is the lecture's loop. The fast engine evaluates the exercise kernel
 // (inlined at link time) on four triangles at once, and every particle still sums the same
-// numbers in the same order as there. The list is cut into groups (triangle_groups):
+// numbers in the same order as there. The loops are templates on the copies' scalar: on doubles
+// they call the exercise's kernel, on floats (the float room) the same formula in float
+// (aerodynamic_force_of, scalar_kernels.hpp). The list is cut into groups (triangle_groups):
 //
 // - a run, such as a grid's row: its triangles alternate between phases whose corners move one
 //   particle per triangle, so the kernel reads them straight from the fast path's rows. The
@@ -15,10 +17,12 @@
 #include "fast/aerodynamics.hpp"
 
 #include <algorithm>
+#include <type_traits>
 #include <utility>
 
 #include "clothlab/forces/aerodynamics.hpp"
 #include "fast/forces.hpp"
+#include "fast/scalar_kernels.hpp"
 
 namespace clothlab::fast {
 
@@ -31,20 +35,27 @@ constexpr Index kTriangleChunk = 128;  // triangles per chunk: 21 KiB of gathere
 // the shares go to rows 0-2 of `share`, kTriangleChunk apart. A run's corners are read where
 // they are; gathered ones from rows kTriangleChunk long. Not inlined, so that its pointers can be
 // declared not to overlap what it writes: then the compiler vectorises the loop.
+template <class S>
 [[gnu::noinline, gnu::flatten]] void aerodynamic_shares(
-    Index count, Index nx, Index nv, const double* __restrict x1, const double* __restrict x2,
-    const double* __restrict x3, const double* __restrict v1, const double* __restrict v2,
-    const double* __restrict v3, double* __restrict share, const Vec3 v_air, double rho,
-    double cd) {
+    Index count, Index nx, Index nv, const S* __restrict x1, const S* __restrict x2,
+    const S* __restrict x3, const S* __restrict v1, const S* __restrict v2, const S* __restrict v3,
+    S* __restrict share, const Vec3Of<S> v_air, S rho, S cd) {
   constexpr Index n = kTriangleChunk;
-  const auto at = [](const double* a, Index stride, Index i) {
-    return Vec3(a[i], a[stride + i], a[2 * stride + i]);
+  const auto at = [](const S* a, Index stride, Index i) {
+    return Vec3Of<S>(a[i], a[stride + i], a[2 * stride + i]);
   };
   for (Index i = 0; i < count; ++i) {
-    const Vec3 f_aero =
-        aerodynamic_force(at(x1, nx, i), at(x2, nx, i), at(x3, nx, i), at(v1, nv, i), at(v2, nv, i),
-                          at(v3, nv, i), v_air, rho, cd);
-    const Vec3 s = f_aero / 3.0;  // each corner carries a third of the triangle
+    // The kernel called here, not through a wrapper: Clang's `flatten` (the page's build)
+    // inlines one level of calls, and the loop vectorises only with the kernel inlined.
+    Vec3Of<S> f_aero;
+    if constexpr (std::is_same_v<S, double>) {
+      f_aero = aerodynamic_force(at(x1, nx, i), at(x2, nx, i), at(x3, nx, i), at(v1, nv, i),
+                                 at(v2, nv, i), at(v3, nv, i), v_air, rho, cd);
+    } else {
+      f_aero = aerodynamic_force_of<S>(at(x1, nx, i), at(x2, nx, i), at(x3, nx, i), at(v1, nv, i),
+                                       at(v2, nv, i), at(v3, nv, i), v_air, rho, cd);
+    }
+    const Vec3Of<S> s = f_aero / S(3);  // each corner carries a third of the triangle
     share[i] = s.x();
     share[n + i] = s.y();
     share[2 * n + i] = s.z();
@@ -52,7 +63,8 @@ constexpr Index kTriangleChunk = 128;  // triangles per chunk: 21 KiB of gathere
 }
 
 // dst[i] += src[i], i = 0 .. count - 1.
-void add_row(Index count, const double* __restrict src, double* __restrict dst) {
+template <class S>
+void add_row(Index count, const S* __restrict src, S* __restrict dst) {
   for (Index i = 0; i < count; ++i)
     dst[i] += src[i];
 }
@@ -60,8 +72,12 @@ void add_row(Index count, const double* __restrict src, double* __restrict dst) 
 }  // namespace
 
 // Aerodynamics::add_forces on the copies, group by group; the groups are cut again when the
-// triangle list changes (Aerodynamics::version).
-class FastAerodynamics final : public FastForce {
+// triangle list changes (Aerodynamics::version). On copies in S: the wind, rho and cd are read
+// at each evaluation (a gust changes the wind) and rounded to S.
+template <class S>
+class FastAerodynamics final : public FastForceOf<S> {
+  using SoA = SoA3Of<S>;
+
  public:
   explicit FastAerodynamics(const Aerodynamics& aero) : aero_(aero) {}
   bool prepare(const Particles& /*p*/) override {
@@ -72,17 +88,20 @@ class FastAerodynamics final : public FastForce {
     }
     return true;
   }
-  void add(const Particles& /*p*/, const SoA3& x, const SoA3& v, SoA3& f, Index begin,
+  void add(const Particles& /*p*/, const SoA& x, const SoA& v, SoA& f, Index begin,
            Index end) const override {
     for (const TriangleGroup& g : groups_)
       add_group(g, x, v, f, begin, end);
   }
 
  private:
-  void add_group(const TriangleGroup& g, const SoA3& x, const SoA3& v, SoA3& f, Index begin,
+  void add_group(const TriangleGroup& g, const SoA& x, const SoA& v, SoA& f, Index begin,
                  Index end) const;
-  void add_triangles(size_t k_begin, size_t k_end, const SoA3& x, const SoA3& v, SoA3& f,
-                     Index begin, Index end) const;
+  void add_triangles(size_t k_begin, size_t k_end, const SoA& x, const SoA& v, SoA& f, Index begin,
+                     Index end) const;
+  Vec3Of<S> wind() const { return aero_.wind().cast<S>(); }
+  S rho() const { return static_cast<S>(aero_.rho()); }
+  S cd() const { return static_cast<S>(aero_.cd()); }
 
   const Aerodynamics& aero_;
   std::vector<TriangleGroup> groups_;
@@ -90,12 +109,13 @@ class FastAerodynamics final : public FastForce {
   unsigned long version_ = 0;
 };
 
-void FastAerodynamics::add_triangles(size_t k_begin, size_t k_end, const SoA3& x, const SoA3& v,
-                                     SoA3& f, Index begin, Index end) const {
+template <class S>
+void FastAerodynamics<S>::add_triangles(size_t k_begin, size_t k_end, const SoA& x, const SoA& v,
+                                        SoA& f, Index begin, Index end) const {
   constexpr Index n = kTriangleChunk;
   const auto in_range = [&](Index i) { return begin <= i && i < end; };
-  double in[18 * n];
-  double share[3 * n];
+  S in[18 * n];
+  S share[3 * n];
   size_t chunk[n];  // which triangle each column of `in` holds
   for (size_t k = k_begin; k < k_end;) {
     Index count = 0;
@@ -113,7 +133,7 @@ void FastAerodynamics::add_triangles(size_t k_begin, size_t k_end, const SoA3& x
     }
     // Rows of `in`: x, y, z of corners 1, 2, 3, then their velocities.
     aerodynamic_shares(count, n, n, in, in + 3 * n, in + 6 * n, in + 9 * n, in + 12 * n,
-                       in + 15 * n, share, aero_.wind(), aero_.rho(), aero_.cd());
+                       in + 15 * n, share, wind(), rho(), cd());
     for (Index q = 0; q < count; ++q) {
       for (Index corner : aero_.triangles()[chunk[q]]) {
         if (!in_range(corner)) continue;
@@ -181,8 +201,9 @@ std::vector<TriangleGroup> triangle_groups(const std::vector<Triangle>& triangle
   return groups;
 }
 
-void FastAerodynamics::add_group(const TriangleGroup& g, const SoA3& x, const SoA3& v, SoA3& f,
-                                 Index begin, Index end) const {
+template <class S>
+void FastAerodynamics<S>::add_group(const TriangleGroup& g, const SoA& x, const SoA& v, SoA& f,
+                                    Index begin, Index end) const {
   if (!g.run) {
     add_triangles(g.k0, g.k0 + g.size, x, v, f, begin, end);
     return;
@@ -199,15 +220,14 @@ void FastAerodynamics::add_group(const TriangleGroup& g, const SoA3& x, const So
   }
   const Index i_begin = std::clamp<Index>(begin - highest, 0, g.length);
   const Index i_end = std::clamp<Index>(end - lowest, 0, g.length);
-  double share[2][3 * n];
+  S share[2][3 * n];
   for (Index i0 = i_begin; i0 < i_end; i0 += n) {
     const Index i1 = std::min(i0 + n, i_end);
     for (int p = 0; p < g.period; ++p) {
       const Triangle& b = g.base[static_cast<size_t>(p)];
       aerodynamic_shares(i1 - i0, x.cols(), v.cols(), x.data() + b[0] + i0, x.data() + b[1] + i0,
                          x.data() + b[2] + i0, v.data() + b[0] + i0, v.data() + b[1] + i0,
-                         v.data() + b[2] + i0, share[static_cast<size_t>(p)], aero_.wind(),
-                         aero_.rho(), aero_.cd());
+                         v.data() + b[2] + i0, share[static_cast<size_t>(p)], wind(), rho(), cd());
     }
     // Every particle takes its shares in the list's order: pass by pass (see triangle_groups).
     for (size_t k = 0; k < passes; ++k) {
@@ -223,8 +243,11 @@ void FastAerodynamics::add_group(const TriangleGroup& g, const SoA3& x, const So
   }
 }
 
-std::unique_ptr<FastForce> fast_aerodynamics(const Aerodynamics& aerodynamics) {
-  return std::make_unique<FastAerodynamics>(aerodynamics);
+template <class S>
+std::unique_ptr<FastForceOf<S>> fast_aerodynamics(const Aerodynamics& aerodynamics) {
+  return std::make_unique<FastAerodynamics<S>>(aerodynamics);
 }
+template std::unique_ptr<FastForceOf<double>> fast_aerodynamics(const Aerodynamics&);
+template std::unique_ptr<FastForceOf<float>> fast_aerodynamics(const Aerodynamics&);
 
 }  // namespace clothlab::fast

@@ -85,7 +85,7 @@ class FastDrag final : public FastForce {
   const FluidDrag& drag_;
 };
 
-// The forms written on either scalar: spring-dampers, gravity, damping.
+// The forms written on either scalar: spring-dampers, gravity, damping, aerodynamics.
 template <class S>
 std::unique_ptr<FastForceOf<S>> fast_force_of(const ForceEffect& effect) {
   if (const auto* springs = dynamic_cast<const SpringDampers*>(&effect))
@@ -94,6 +94,8 @@ std::unique_ptr<FastForceOf<S>> fast_force_of(const ForceEffect& effect) {
     return std::make_unique<FastGravity<S>>(*gravity);
   if (const auto* damping = dynamic_cast<const Damping*>(&effect))
     return std::make_unique<FastDamping<S>>(*damping);
+  if (const auto* aero = dynamic_cast<const Aerodynamics*>(&effect))
+    return fast_aerodynamics<S>(*aero);
   return nullptr;
 }
 
@@ -101,8 +103,6 @@ std::unique_ptr<FastForceOf<S>> fast_force_of(const ForceEffect& effect) {
 
 std::unique_ptr<FastForce> fast_force(const ForceEffect& effect) {
   if (std::unique_ptr<FastForce> fast = fast_force_of<double>(effect)) return fast;
-  if (const auto* aero = dynamic_cast<const Aerodynamics*>(&effect))
-    return fast_aerodynamics(*aero);
   if (const auto* drag = dynamic_cast<const FluidDrag*>(&effect))
     return std::make_unique<FastDrag>(*drag);
   return nullptr;

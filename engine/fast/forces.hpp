@@ -73,12 +73,13 @@ struct FastForceSlot {
 std::unique_ptr<FastForce> fast_force(const ForceEffect& effect);
 
 // Its float form for the float room, or null when the float room does not cover it: gravity,
-// damping and spring-dampers (springs, bending).
+// damping, spring-dampers (springs, bending) and aerodynamics.
 std::unique_ptr<FastForceOf<float>> fast_force_float(const ForceEffect& effect);
 
 // The ones with files of their own (springs.cpp, aerodynamics.cpp).
 template <class Scalar>
 std::unique_ptr<FastForceOf<Scalar>> fast_springs(const SpringDampers& springs);
-std::unique_ptr<FastForce> fast_aerodynamics(const Aerodynamics& aerodynamics);
+template <class Scalar>
+std::unique_ptr<FastForceOf<Scalar>> fast_aerodynamics(const Aerodynamics& aerodynamics);
 
 }  // namespace clothlab::fast

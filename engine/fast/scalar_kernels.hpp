@@ -13,6 +13,7 @@
 #include <cmath>
 
 #include "clothlab/core/types.hpp"
+#include "clothlab/forces/aerodynamics.hpp"
 #include "clothlab/forces/spring_damper.hpp"
 
 namespace clothlab::fast {
@@ -30,23 +31,43 @@ Vec3Of<Scalar> spring_force(const Vec3Of<Scalar>& r1, const Vec3Of<Scalar>& r2,
                             Scalar kd, Scalar l0) {
   const Vec3Of<Scalar> e_star = r2 - r1;  // [m]
   const Scalar l = e_star.norm();
-  if (l == Scalar(0)) return Vec3Of<Scalar>::Zero();
   const Vec3Of<Scalar> e = e_star * (Scalar(1) / l);                  // one division
   const Scalar f_sd = -ks * (l0 - l) - kd * (e.dot(v1) - e.dot(v2));  // [N]
-  return f_sd * e;
+  // Coincident ends (l = 0, e not a number) give no force. Chosen at the end, not by returning
+  // early: then a loop over springs reads every spring's inputs whatever its l, and Clang takes
+  // several springs an instruction (in the page's WebAssembly, the early return kept it to one).
+  return l == Scalar(0) ? Vec3Of<Scalar>::Zero().eval() : (f_sd * e).eval();
 }
 
 // The spring kernel the fast path's loops call on Scalar: the exercise's on doubles, the one
 // above on floats. The constants stay doubles in the spring set (plasticity changes l0 in place
-// every step), and are rounded to the scalar as they are read.
+// every step); the float room rounds them to float once, when they change (springs.cpp).
 inline Vec3 spring_kernel(const Vec3& r1, const Vec3& r2, const Vec3& v1, const Vec3& v2, double ks,
                           double kd, double l0) {
   return spring_damper_force(r1, r2, v1, v2, ks, kd, l0);
 }
 inline Vec3f spring_kernel(const Vec3f& r1, const Vec3f& r2, const Vec3f& v1, const Vec3f& v2,
-                           double ks, double kd, double l0) {
-  return spring_force<float>(r1, r2, v1, v2, static_cast<float>(ks), static_cast<float>(kd),
-                             static_cast<float>(l0));
+                           float ks, float kd, float l0) {
+  return spring_force<float>(r1, r2, v1, v2, ks, kd, l0);
+}
+
+// Lesson 03's air on a triangle, the whole force [N] (each corner takes a third):
+//   v = (v1 + v2 + v3) / 3 - v_air (each corner's relative velocity first),
+//   n* = (r2 - r1) x (r3 - r1),  f = -1/2 rho cd (|v| (v . n*) / (2 |n*|)) n*,
+// zero for a triangle of no area or no relative velocity (as the reference kernel,
+// solutions/03_aerodynamics.cpp).
+template <class Scalar>
+Vec3Of<Scalar> aerodynamic_force_of(const Vec3Of<Scalar>& r1, const Vec3Of<Scalar>& r2,
+                                    const Vec3Of<Scalar>& r3, const Vec3Of<Scalar>& v1,
+                                    const Vec3Of<Scalar>& v2, const Vec3Of<Scalar>& v3,
+                                    const Vec3Of<Scalar>& v_air, Scalar rho, Scalar cd) {
+  const Vec3Of<Scalar> v = ((v1 - v_air) + (v2 - v_air) + (v3 - v_air)) / Scalar(3);  // [m/s]
+  const Vec3Of<Scalar> n_star = (r2 - r1).cross(r3 - r1);  // |n*| = twice the area [m^2]
+  const Scalar n_star_norm = n_star.norm();
+  const Scalar speed = v.norm();
+  if (n_star_norm == Scalar(0) || speed == Scalar(0)) return Vec3Of<Scalar>::Zero();
+  const Vec3Of<Scalar> v2_a_n = (speed * v.dot(n_star) / (Scalar(2) * n_star_norm)) * n_star;
+  return Scalar(-0.5) * rho * cd * v2_a_n;
 }
 
 // Lesson 01's Euler steps of one particle, a = f / m (inv_m = 0 for a pinned one):

@@ -37,6 +37,7 @@
 #include "fast/springs.hpp"
 
 #include <algorithm>
+#include <array>
 #include <type_traits>
 
 #include "fast/forces.hpp"
@@ -172,13 +173,14 @@ namespace {
 // A function of its own, not inlined, so that every pointer can be declared not to overlap the
 // others: then the compiler vectorises the loop, kernel inlined. With Uniform, ks[0] and kd[0]
 // serve every spring: read once, outside the loop, instead of two more numbers per spring.
-// S is the scalar of the copies: double on the fast path (the exercise's kernel), float in the
-// float room (spring_kernel, scalar_kernels.hpp); the constants are the set's doubles.
+// S is the scalar of the copies and of the constants: double on the fast path (the exercise's
+// kernel on the set's own arrays), float in the float room (spring_kernel, scalar_kernels.hpp, on
+// the constants rounded once: FastSprings::Rounded).
 template <class S, bool Uniform>
 [[gnu::noinline]] void forces_of_run(Index count, Index nx, Index nv, const S* __restrict x1,
                                      const S* __restrict x2, const S* __restrict v1,
-                                     const S* __restrict v2, const double* __restrict ks,
-                                     const double* __restrict kd, const double* __restrict l0,
+                                     const S* __restrict v2, const S* __restrict ks,
+                                     const S* __restrict kd, const S* __restrict l0,
                                      S* __restrict f1x, S* __restrict f1y, S* __restrict f1z) {
   using V = Vec3Of<S>;
   for (Index t = 0; t < count; ++t) {
@@ -208,8 +210,7 @@ template <class S>
 constexpr bool kWholeVectorEnds = kVectorLanes<S> > 2;
 template <class S, bool Uniform>
 void forces_in_vectors(Index count, Index nx, Index nv, const S* x1, const S* x2, const S* v1,
-                       const S* v2, const double* ks, const double* kd, const double* l0, S* f1x,
-                       S* f1y, S* f1z) {
+                       const S* v2, const S* ks, const S* kd, const S* l0, S* f1x, S* f1y, S* f1z) {
   constexpr Index kLanes = kVectorLanes<S>;
   const Index whole = count - count % kLanes;
   if (!kWholeVectorEnds<S> || whole == count || whole == 0) {
@@ -269,8 +270,8 @@ constexpr Index kChunk = 256;  // springs per chunk: f1 of a chunk takes 6 KiB
 template <class S, bool Uniform, bool UpperIsJ, bool ToUpper, bool ToLower>
 [[gnu::noinline, gnu::flatten]] void run_kernel_direct(
     Index count, Index nx, Index nv, Index n, const S* __restrict x1, const S* __restrict x2,
-    const S* __restrict v1, const S* __restrict v2, const double* __restrict ks,
-    const double* __restrict kd, const double* __restrict l0, S* f_upper, S* f_lower) {
+    const S* __restrict v1, const S* __restrict v2, const S* __restrict ks, const S* __restrict kd,
+    const S* __restrict l0, S* f_upper, S* f_lower) {
   using V = Vec3Of<S>;
   // No two springs the compiler takes at once touch the same particle (see kDirectGap).
   CLOTHLAB_INDEPENDENT_ITERATIONS
@@ -342,10 +343,11 @@ namespace {
 
 // The springs of a run, or of one row of a stencil, as the loops below read them: spring t joins
 // particles i0 + t and j0 + t, with constants ks[t], kd[t] (ks[0] and kd[0] if uniform) and
-// l0[t].
+// l0[t], in the copies' scalar S.
+template <class S>
 struct RunView {
   Index i0, j0, length;
-  const double *ks, *kd, *l0;
+  const S *ks, *kd, *l0;
   bool uniform;
 };
 
@@ -369,11 +371,13 @@ class FastSprings final : public FastForceOf<S> {
       version_ = s.version();
       rest_version_ = s.rest_version();
       built_ = true;
+      round_constants();
     } else if (rest_version_ != s.rest_version()) {
       // A rest length moved: the springs it left no longer belong in a stencil. Runs read the
       // set's rest lengths where they are, so a layout without stencils stands as it is.
       if (!layout_.stencils.empty()) layout_ = spring_layout(s, runs_);
       rest_version_ = s.rest_version();
+      round_constants();
     }
     // Runs of a few springs cost more in bookkeeping than they save: such a set (springs given
     // one by one, or shuffled) is left to add_forces. The float room has no add_forces in float
@@ -386,10 +390,10 @@ class FastSprings final : public FastForceOf<S> {
            Index end) const override {
     // In the set's order: each stencil after the runs that come before it.
     size_t next = 0;
-    for (const SpringStencil& stencil : layout_.stencils) {
-      for (; next < stencil.runs_before; ++next)
+    for (size_t k = 0; k < layout_.stencils.size(); ++k) {
+      for (; next < layout_.stencils[k].runs_before; ++next)
         add_run(view(layout_.runs[next]), begin, end, x, v, f);
-      add_stencil(stencil, begin, end, x, v, f);
+      add_stencil(k, begin, end, x, v, f);
     }
     for (; next < layout_.runs.size(); ++next)
       add_run(view(layout_.runs[next]), begin, end, x, v, f);
@@ -421,27 +425,76 @@ class FastSprings final : public FastForceOf<S> {
   }
 
  private:
-  RunView view(const SpringRun& run) const {
-    const SpringSet& s = springs_.springs();
-    return {run.i0,
-            run.j0,
-            run.length,
-            s.ks().data() + run.k0,
-            s.kd().data() + run.k0,
-            s.l0().data() + run.k0,
-            run.uniform};
+  // The float room's constants: the set's ks, kd and l0 and each stencil's, rounded to float
+  // once, when the set or a rest length changes (prepare), not as each spring reads them: a loop
+  // that reads doubles beside its floats takes as few floats an instruction as doubles (two in
+  // the page's WebAssembly, where its floats would take four). Rounded once or as read, a
+  // constant is the same float. The fast path (double) reads the set's own arrays.
+  struct Rounded {
+    std::vector<S> ks, kd, l0;
+    std::vector<std::array<S, 2>> stencil_k;  // each stencil's ks and kd
+    std::vector<std::vector<S>> stencil_l0;   // and its rows of rest lengths
+  };
+  void round_constants() {
+    if constexpr (!std::is_same_v<S, double>) {
+      const SpringSet& s = springs_.springs();
+      const auto rounded = [](const std::vector<double>& a) {
+        return std::vector<S>(a.begin(), a.end());
+      };
+      rounded_.ks = rounded(s.ks());
+      rounded_.kd = rounded(s.kd());
+      rounded_.l0 = rounded(s.l0());
+      rounded_.stencil_k.clear();
+      rounded_.stencil_l0.clear();
+      for (const SpringStencil& stencil : layout_.stencils) {
+        rounded_.stencil_k.push_back({static_cast<S>(stencil.ks), static_cast<S>(stencil.kd)});
+        rounded_.stencil_l0.push_back(rounded(stencil.l0));
+      }
+    }
+  }
+
+  RunView<S> view(const SpringRun& run) const {
+    if constexpr (std::is_same_v<S, double>) {
+      const SpringSet& s = springs_.springs();
+      return {run.i0,
+              run.j0,
+              run.length,
+              s.ks().data() + run.k0,
+              s.kd().data() + run.k0,
+              s.l0().data() + run.k0,
+              run.uniform};
+    } else {
+      return {run.i0,
+              run.j0,
+              run.length,
+              rounded_.ks.data() + run.k0,
+              rounded_.kd.data() + run.k0,
+              rounded_.l0.data() + run.k0,
+              run.uniform};
+    }
   }
   // Adds the forces of the springs of `run` on the particles [p_begin, p_end) to f.
-  void add_run(const RunView& run, Index p_begin, Index p_end, const SoA& x, const SoA& v,
+  void add_run(const RunView<S>& run, Index p_begin, Index p_end, const SoA& x, const SoA& v,
                SoA& f) const;
   // The same for a run whose ends are kDirectGap or more apart, without the buffer: springs
   // [up_begin, up_end) have their upper end in range, [lo_begin, lo_end) their lower end.
-  void add_run_direct(const RunView& run, Index up_begin, Index up_end, Index lo_begin,
+  void add_run_direct(const RunView<S>& run, Index up_begin, Index up_end, Index lo_begin,
                       Index lo_end, const SoA& x, const SoA& v, SoA& f) const;
   // The same for the rows of a stencil with an end in range, row after row: the rows come in
   // the set's order, and a particle meets them in the order add_forces adds them.
-  void add_stencil(const SpringStencil& stencil, Index p_begin, Index p_end, const SoA& x,
-                   const SoA& v, SoA& f) const {
+  void add_stencil(size_t index, Index p_begin, Index p_end, const SoA& x, const SoA& v,
+                   SoA& f) const {
+    const SpringStencil& stencil = layout_.stencils[index];
+    const S *ks, *kd, *l0;  // the stencil's constants: its own, or the float room's
+    if constexpr (std::is_same_v<S, double>) {
+      ks = &stencil.ks;
+      kd = &stencil.kd;
+      l0 = stencil.l0.data();
+    } else {
+      ks = &rounded_.stencil_k[index][0];
+      kd = &rounded_.stencil_k[index][1];
+      l0 = rounded_.stencil_l0[index].data();
+    }
     const Index lower = std::min(stencil.i0, stencil.j0), upper = std::max(stencil.i0, stencil.j0);
     // Row r's ends lie in [lower + r stride, upper + r stride + length): the rows that reach
     // [p_begin, p_end), or a row more (add_run finds it has nothing there).
@@ -450,8 +503,8 @@ class FastSprings final : public FastForceOf<S> {
         p_end <= lower ? 0 : std::min(stencil.rows, (p_end - lower) / stencil.stride + 1);
     for (Index r = r0; r < r1; ++r) {
       const Index shift = r * stencil.stride;
-      add_run({stencil.i0 + shift, stencil.j0 + shift, stencil.length, &stencil.ks, &stencil.kd,
-               stencil.l0.data() + stencil.row_l0[static_cast<size_t>(r)], true},
+      add_run({stencil.i0 + shift, stencil.j0 + shift, stencil.length, ks, kd,
+               l0 + stencil.row_l0[static_cast<size_t>(r)], true},
               p_begin, p_end, x, v, f);
     }
   }
@@ -462,10 +515,11 @@ class FastSprings final : public FastForceOf<S> {
   bool built_ = false;
   unsigned long version_ = 0, rest_version_ = 0;
   std::vector<double> energies_;  // potential_energy's, one a spring in the set's order
+  Rounded rounded_;               // the float room's constants (empty on doubles)
 };
 
 template <class S>
-void FastSprings<S>::add_run(const RunView& run, Index p_begin, Index p_end, const SoA& x,
+void FastSprings<S>::add_run(const RunView<S>& run, Index p_begin, Index p_end, const SoA& x,
                              const SoA& v, SoA& f) const {
   const Index n = f.cols();  // the stride of f's rows (of x's: x.cols(), of v's: v.cols())
   const Index lower = std::min(run.i0, run.j0), upper = std::max(run.i0, run.j0);
@@ -521,7 +575,7 @@ void FastSprings<S>::add_run(const RunView& run, Index p_begin, Index p_end, con
 }
 
 template <class S>
-void FastSprings<S>::add_run_direct(const RunView& run, Index up_begin, Index up_end,
+void FastSprings<S>::add_run_direct(const RunView<S>& run, Index up_begin, Index up_end,
                                     Index lo_begin, Index lo_end, const SoA& x, const SoA& v,
                                     SoA& f) const {
   const Index lower = std::min(run.i0, run.j0), upper = std::max(run.i0, run.j0);

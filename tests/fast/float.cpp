@@ -6,9 +6,11 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <functional>
 #include <limits>
 #include <random>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "analysis/stability.hpp"
@@ -100,6 +102,46 @@ TEST_CASE("float: a step wakes the threads once") {
   }
 }
 
+TEST_CASE("float: the float room reads the rest lengths and constants the set has now") {
+  // The float room rounds the springs' constants to float once, when the set changes. A rest
+  // length set between two steps (set_l0, as a program or a tool may) and a stiffness set on a
+  // whole family (set_ks) must reach its next step: the run is the same, bit for bit, as one
+  // whose engine room is made anew at that step and so rounds the new constants from scratch.
+  // (The cloth's row springs are in a stencil, so its rows of rest lengths are tested as well.)
+  const auto edited = [](bool fresh_room, const std::function<void(clothlab::SpringSet&)>& edit) {
+    clothlab::Scene scene = steps(cloth(), 10);
+    clothlab::SpringSet* set = nullptr;
+    for (auto& effect : scene.world.force_effects) {
+      if (auto* springs = dynamic_cast<clothlab::SpringDampers*>(effect.get()); springs && !set)
+        set = &springs->springs();
+    }
+    REQUIRE(set != nullptr);
+    edit(*set);
+    if (fresh_room) {
+      scene.world.backend = clothlab::fast::make_fast_engine();
+      REQUIRE(clothlab::fast::use_float(scene.world).empty());
+    }
+    for (int s = 0; s < 10; ++s)
+      scene.world.step(scene.dt);
+    return Matrix3X(scene.world.particles.x);
+  };
+  const Matrix3X plain = edited(false, [](clothlab::SpringSet&) {});
+  const std::vector<std::pair<const char*, std::function<void(clothlab::SpringSet&)>>> edits = {
+      {"a rest length", [](clothlab::SpringSet& s) { s.set_l0(40, 1.5 * s.l0(40)); }},
+      {"every stiffness", [](clothlab::SpringSet& s) {
+         for (size_t k = 0; k < s.size(); ++k)
+           s.set_ks(k, 2.0 * s.ks(k));
+       }}};
+  for (const auto& [name, edit] : edits) {
+    const std::string what = name;
+    CAPTURE(what);
+    const Matrix3X kept = edited(false, edit);
+    const Matrix3X fresh = edited(true, edit);
+    CHECK((kept.array() != plain.array()).any());  // the edit changes the motion
+    CHECK((kept.array() == fresh.array()).all());  // and the float room saw it at once
+  }
+}
+
 TEST_CASE("float: explicit Euler moves with the old velocity") {
   // One step from rest under gravity alone: symplectic Euler moves the free particles by
   // g dt^2, explicit Euler not at all (it moves with v = 0). A float room that took the wrong
@@ -147,6 +189,62 @@ TEST_CASE("float: the float spring kernel is the lecture's spring-damper") {
             .isZero());
 }
 
+TEST_CASE("float: the float aerodynamic kernel is the lecture's air on a triangle") {
+  // aerodynamic_force_of (scalar_kernels.hpp) in double against the exercise's kernel: the same
+  // formula, so within a few roundings; in float within float's; zero for a triangle of no area
+  // or one moving with the air, as the reference.
+  using clothlab::Vec3;
+  using clothlab::fast::aerodynamic_force_of;
+  using clothlab::fast::Vec3f;
+  const Vec3 r1(0.1, -0.2, 0.3), r2(0.4, 0.5, -0.1), r3(-0.3, 0.2, 0.6);
+  const Vec3 v1(1.0, 0.2, -0.3), v2(-0.5, 0.1, 0.7), v3(0.3, -0.4, 0.2), air(4.0, 0.5, -1.0);
+  const Vec3 b = clothlab::aerodynamic_force(r1, r2, r3, v1, v2, v3, air, 1.225, 1.1);
+  REQUIRE(b.norm() > 0.1);
+  const Vec3 a = aerodynamic_force_of<double>(r1, r2, r3, v1, v2, v3, air, 1.225, 1.1);
+  CHECK((a - b).norm() <= 1e-14 * b.norm());
+  const Vec3f f = aerodynamic_force_of<float>(r1.cast<float>(), r2.cast<float>(), r3.cast<float>(),
+                                              v1.cast<float>(), v2.cast<float>(), v3.cast<float>(),
+                                              air.cast<float>(), 1.225f, 1.1f);
+  CHECK((f.cast<double>() - b).norm() <= 1e-6 * b.norm());
+  // The force does not depend on the winding, and a flat triangle or still air gives none.
+  const Vec3f flipped = aerodynamic_force_of<float>(
+      r1.cast<float>(), r3.cast<float>(), r2.cast<float>(), v1.cast<float>(), v3.cast<float>(),
+      v2.cast<float>(), air.cast<float>(), 1.225f, 1.1f);
+  CHECK((flipped - f).norm() <= 1e-6f * f.norm());
+  CHECK(aerodynamic_force_of<float>(r1.cast<float>(), r2.cast<float>(), r2.cast<float>(),
+                                    v1.cast<float>(), v2.cast<float>(), v3.cast<float>(),
+                                    air.cast<float>(), 1.225f, 1.1f)
+            .isZero());
+  const Vec3f still = air.cast<float>();
+  CHECK(aerodynamic_force_of<float>(r1.cast<float>(), r2.cast<float>(), r3.cast<float>(), still,
+                                    still, still, still, 1.225f, 1.1f)
+            .isZero());
+}
+
+TEST_CASE("float: a flag in the wind steps its air in float, on any number of threads") {
+  // A cloth in a gusty wind: the float room sums the air on floats (every number it writes is a
+  // float), stays near the double run, and gives the same bits on 1 to 4 threads (the triangles
+  // at a border between two ranges are taken by both, each adding to its own corners).
+  const std::string air = "[aerodynamics]\nwind = [6, 0, 2]\ngust = [3, 0, 1]\ngust_period = 0.2\n";
+  const clothlab::Scene single = steps(cloth("symplectic-euler", 0.0005, air), 200);
+  const clothlab::Scene full = steps(cloth("symplectic-euler", 0.0005, air, "double"), 200);
+  const clothlab::Scene calm = steps(cloth(), 200);
+  CHECK(all_floats(single.world.particles.x));
+  CHECK(all_floats(single.world.particles.f));
+  const Matrix3X& x = single.world.particles.x;
+  const double gap = (x - full.world.particles.x).cwiseAbs().maxCoeff();
+  const double moved_by_air = (x - calm.world.particles.x).cwiseAbs().maxCoeff();
+  CAPTURE(gap);
+  CAPTURE(moved_by_air);
+  CHECK(moved_by_air > 1e-3);        // the air did move the cloth
+  CHECK(gap < 1e-3 * moved_by_air);  // and float moved it as double did
+  for (int threads = 2; threads <= 4; ++threads) {
+    CAPTURE(threads);
+    const clothlab::Scene scene = steps(cloth("symplectic-euler", 0.0005, air), 200, threads);
+    CHECK((scene.world.particles.x.array() == x.array()).all());
+  }
+}
+
 TEST_CASE("float: a bad precision or a scene float does not cover is an error at the key") {
   // A value that is not a precision: file, line and column of the value, what was expected.
   const std::string half = load_error(cloth("symplectic-euler", 0.0005, "", "half"));
@@ -162,9 +260,11 @@ TEST_CASE("float: a bad precision or a scene float does not cover is an error at
     CHECK(error.find(std::string(clothlab::fast::kFloatCovers)) != std::string::npos);
   }
   // Effects it does not cover, named, never a quiet step in double.
-  const std::string aero =
-      load_error(cloth("symplectic-euler", 0.0005, "[aerodynamics]\nwind = [2, 0, 1]\n"));
-  CHECK(aero.find("the effect aerodynamics;") != std::string::npos);
+  const std::string drag = load_error(cloth("symplectic-euler", 0.0005, "[drag]\narea = 0.0004\n"));
+  CHECK(drag.find("the effect drag;") != std::string::npos);
+  // Aerodynamics it covers.
+  CHECK(
+      load_error(cloth("symplectic-euler", 0.0005, "[aerodynamics]\nwind = [2, 0, 1]\n")).empty());
   const std::string two = load_error(
       cloth("symplectic-euler", 0.0005, "[drag]\narea = 0.0004\n[tearing]\nstrain = 0.5\n"));
   CHECK(two.find("the effects drag, tearing") != std::string::npos);
@@ -254,15 +354,20 @@ TEST_CASE("float: every lesson scene float covers stays near its double run") {
   // amplify a difference, these errors add up at worst, so after N steps
   //   max |x_float - x_double| <= k N u L.
   // A scene may amplify one: a contact's static friction holds a particle or lets it slide on
-  // a threshold, and a sheet laid symmetrically on a ball slides off one way or the other, which
-  // a rounding decides. Such a scene parts from itself in double just as well, so the test
-  // measures its spread D: the double run against the same run started with every coordinate
-  // moved by one rounding's worth, x (1 + u r), r uniform in [-1, 1] (a seeded draw: rounding
-  // to float would keep a symmetric sheet symmetric, where float arithmetic does not). Where D
-  // is more than k N u L the scene amplifies a rounding more than N steps of them add up, and
-  // all a test can ask is that the float run stays within that spread (twice D: D is one draw
-  // of it). So the bound is max(k N u L, 2 D). The measured ratios (printed) sit well under it:
-  // 0.05 or less where k N u L sets it, 0.11 on cloth-on-sphere, the one scene where 2 D does.
+  // a threshold, a sheet laid symmetrically on a ball slides off one way or the other, which a
+  // rounding decides, and a flag flapping in the wind or a sheet tumbling as it falls parts
+  // from any nearby run by a factor at every flap. Such a scene parts from itself in double
+  // just as well, so the test measures its spread D: the double run against the same run with
+  // every coordinate and velocity moved by one float rounding's worth, x (1 + u r) and
+  // v (1 + u r), r uniform in [-1, 1] (a seeded draw), at the start and after every step: float's
+  // roundings, of float's size and at float's pace, but random (rounding to float would keep a
+  // symmetric sheet symmetric, where float arithmetic does not). Where D is more than k N u L
+  // the scene amplifies its roundings more than they add up, and all a test can ask is that the
+  // float run stays within that spread (twice D: D is one draw of it). So the bound is
+  // max(k N u L, 2 D). The measured ratios (printed) sit well under it: 0.12 or less where
+  // k N u L sets it (gusty-flag), 0.26 or less where 2 D does (stiff-sheet-edge; the flag, the
+  // falling sheet and cloth-on-sphere 0.05 to 0.10). A scene made to blow up must blow up in
+  // float too, at the same step.
   constexpr double u = 0x1p-24;
   constexpr double k = 8.0;
   constexpr long kMaxSteps = 2000;  // the first 2000 steps of a longer run (seconds in all)
@@ -277,11 +382,16 @@ TEST_CASE("float: every lesson scene float covers stays near its double run") {
     CAPTURE(path.string());
     clothlab::Scene full = clothlab::load_scene_file(path);
     clothlab::Scene single = clothlab::load_scene_file(path);
-    clothlab::Scene nudged = clothlab::load_scene_file(path);  // double, from a float start
+    clothlab::Scene nudged = clothlab::load_scene_file(path);  // double, nudged at every step
     std::mt19937 random(43);
     std::uniform_real_distribution<double> r(-1.0, 1.0);
-    for (double& x : nudged.world.particles.x.reshaped())
-      x *= 1.0 + u * r(random);
+    const auto nudge = [&] {
+      for (double& x : nudged.world.particles.x.reshaped())
+        x *= 1.0 + u * r(random);
+      for (double& v : nudged.world.particles.v.reshaped())
+        v *= 1.0 + u * r(random);
+    };
+    nudge();
     if (!full.world.backend) {
       ++declined;  // the scene asks for the readable engine: double only
       continue;
@@ -296,12 +406,35 @@ TEST_CASE("float: every lesson scene float covers stays near its double run") {
     ++covered;
     const long n = std::min(full.step_count(), kMaxSteps);
     double reach = 0.0;  // L [m]
-    for (long s = 0; s < n; ++s) {
-      full.world.step(full.dt);
-      single.world.step(single.dt);
-      nudged.world.step(nudged.dt);
-      reach = std::max(reach, full.world.particles.x.cwiseAbs().maxCoeff());
+    // A scene made to blow up (lesson 08's stiff sheet) must blow up in float too, the guard
+    // stopping it at the step where it stops the double run, or the next.
+    long full_stop = -1, single_stop = -1;
+    const auto step = [](clothlab::Scene& scene, long s, long& stop) {
+      if (stop >= 0) return;
+      try {
+        scene.world.step(scene.dt);
+      } catch (const clothlab::SimulationError&) {
+        stop = s;
+      }
+    };
+    for (long s = 0; s < n && full_stop < 0; ++s) {
+      step(full, s, full_stop);
+      step(single, s, single_stop);
+      if (full_stop < 0) {
+        nudged.world.step(nudged.dt);
+        nudge();
+        reach = std::max(reach, full.world.particles.x.cwiseAbs().maxCoeff());
+      }
     }
+    if (full_stop >= 0) {
+      step(single, full_stop + 1, single_stop);  // the next step, where float has not stopped
+      MESSAGE(path.filename().string() << ": the guard stops the double run at step " << full_stop
+                                       << ", the float run at step " << single_stop);
+      CHECK(single_stop >= full_stop);
+      CHECK(single_stop <= full_stop + 1);
+      continue;
+    }
+    CHECK(single_stop == -1);
     REQUIRE(single.world.backend_evaluations == n);
     // Every number the float room wrote is a float; contacts and pins then move particles in
     // double, after the step.
