@@ -15,6 +15,10 @@ simulated time in 1/60 s frames each way, drawing nothing (as the native run dra
   module  each frame the module's call alone (clothlab_advance): what the step costs inside the
           WebAssembly module; page minus module is the JavaScript around it.
 
+With --float the page steps the scene in single precision (`[engine] precision = "float"` put
+into its text) and two native runs take their turn each time, one in double as the scene is
+written and one with `clothlab run --float`: the ratios are printed against both.
+
 A native run and a repeat in the page take turns, so that both meet the same load. Each is
 timed twice: in real time (the run's own "done: N steps in T s", the page's clock), and in
 processor time (the native process's, its start and its frames written included; the page's
@@ -183,11 +187,12 @@ class DevTools:
         return result["result"].get("value")
 
 
-def native(clothlab: str, scene: pathlib.Path, work: pathlib.Path) -> dict:
-    """ms per step of one native run: real time as the run reports it, and the processor time
-    of the whole process (its start and its frames written included)."""
-    with subprocess.Popen([clothlab, "run", str(scene), "--no-html", "--threads", "1", "--out",
-                           str(work / "native")], stdout=subprocess.PIPE, text=True) as run:
+def native(clothlab: str, scene: pathlib.Path, work: pathlib.Path, single: bool = False) -> dict:
+    """ms per step of one native run (in float if `single`): real time as the run reports it, and
+    the processor time of the whole process (its start and its frames written included)."""
+    command = [clothlab, "run", str(scene), "--no-html", "--threads", "1", "--out",
+               str(work / "native")] + (["--float"] if single else [])
+    with subprocess.Popen(command, stdout=subprocess.PIPE, text=True) as run:
         out = run.stdout.read()
         _, status, usage = os.wait4(run.pid, 0)
         run.returncode = os.waitstatus_to_exitcode(status)
@@ -220,9 +225,20 @@ def renderers(profile: pathlib.Path) -> list:
     return found
 
 
-def open_page(page: pathlib.Path, scene: pathlib.Path, work: pathlib.Path):
+def in_float(text: str) -> str:
+    """The scene's text with `[engine] precision = "float"` in it."""
+    if re.search(r"^\s*precision\s*=", text, re.MULTILINE):
+        sys.exit("bench_live: --float on a scene that sets its precision itself")
+    header = re.search(r"^\[engine\][^\n]*\n", text, re.MULTILINE)
+    if header:
+        return text[:header.end()] + 'precision = "float"\n' + text[header.end():]
+    return text + '\n[engine]\nprecision = "float"\n'
+
+
+def open_page(page: pathlib.Path, scene: pathlib.Path, work: pathlib.Path, single: bool = False):
     """Headless Chromium on a copy of `page` with the bench in it: the browser's process and a
-    DevTools connection to the page, once the engine has started and warmed up on `scene`."""
+    DevTools connection to the page, once the engine has started and warmed up on `scene` (in
+    float if `single`)."""
     work.mkdir(exist_ok=True)
     copy = work / page.name
     copy.write_text(page.read_text(encoding="utf-8").replace("</body>", BENCH + "\n</body>", 1),
@@ -240,7 +256,8 @@ def open_page(page: pathlib.Path, scene: pathlib.Path, work: pathlib.Path):
                                start_new_session=True)
     try:
         tools = connect(process, profile)
-        data = json.dumps({"name": str(scene), "text": scene.read_text(encoding="utf-8")})
+        text = scene.read_text(encoding="utf-8")
+        data = json.dumps({"name": str(scene), "text": in_float(text) if single else text})
         problem = tools.evaluate(f"clothlabBenchStart({data})")
         if problem:
             sys.exit(f"bench_live: the page could not run the scene: {problem}")
@@ -301,17 +318,19 @@ def connect(process: subprocess.Popen, profile: pathlib.Path) -> DevTools:
 
 
 def measure(clothlab: str, page: pathlib.Path, scene: pathlib.Path, seconds: float,
-            repeats: int, work: pathlib.Path) -> dict:
+            repeats: int, work: pathlib.Path, single: bool = False) -> dict:
     """The native runs and the page's repeats, taken in turns (a native run, then a repeat in
     the page each way), so that both meet the same load on a shared machine. Each repeat in the
     page is timed by the page's clock (real time) and by the processor time of the renderer's
     main thread, where the page runs (the renderer whose main thread worked most)."""
-    process, tools = open_page(page, scene, work)
+    process, tools = open_page(page, scene, work, single)
     try:
         pids = renderers(work / "browser")
-        natives, repeated = [], {"page": [], "module": []}
+        natives, natives_float, repeated = [], [], {"page": [], "module": []}
         for _ in range(repeats):
             natives.append(native(clothlab, scene, work))
+            if single:
+                natives_float.append(native(clothlab, scene, work, single=True))
             for way in repeated:
                 before = {pid: thread_seconds(pid) for pid in pids}
                 result = tools.evaluate(f"clothlabBenchRepeat({seconds}, '{way}')")
@@ -324,14 +343,16 @@ def measure(clothlab: str, page: pathlib.Path, scene: pathlib.Path, seconds: flo
         drawn = tools.evaluate("clothlabBenchDrawn()")
         if drawn["error"]:
             sys.exit(f"bench_live: the page stopped: {drawn['error']}")
-        return {"natives": natives, "repeats": repeated, "drawn": drawn}
+        return {"natives": natives, "natives_float": natives_float, "repeats": repeated,
+                "drawn": drawn}
     finally:
         stop(process)
 
 
-def profile(page: pathlib.Path, scene: pathlib.Path, seconds: float, work: pathlib.Path) -> None:
+def profile(page: pathlib.Path, scene: pathlib.Path, seconds: float, work: pathlib.Path,
+            single: bool = False) -> None:
     """The page's stepping under the sampling profiler: the functions by self time."""
-    process, tools = open_page(page, scene, work)
+    process, tools = open_page(page, scene, work, single)
     try:
         tools.call("Profiler.enable")
         tools.call("Profiler.setSamplingInterval", interval=100)  # microseconds
@@ -366,18 +387,21 @@ def main() -> None:
     parser.add_argument("--repeats", type=int, default=5, help="runs of each (default 5)")
     parser.add_argument("--profile", action="store_true",
                         help="also profile the page's stepping and list where its time goes")
+    parser.add_argument("--float", dest="single", action="store_true",
+                        help="the page in single precision, against native in double and in float")
     args = parser.parse_args()
     if args.repeats < 1 or not args.seconds > 0:
         sys.exit("bench_live: --repeats must be at least 1 and --seconds above 0")
     with tempfile.TemporaryDirectory(prefix="clothlab-bench-live-") as work:
         found = measure(args.clothlab, args.page, args.scene, args.seconds, args.repeats,
-                        pathlib.Path(work))
+                        pathlib.Path(work), args.single)
         if args.profile:
-            profile(args.page, args.scene, args.seconds, pathlib.Path(work) / "profiled")
+            profile(args.page, args.scene, args.seconds, pathlib.Path(work) / "profiled",
+                    args.single)
     listed = lambda values: ", ".join(f"{v:.4f}" for v in values)
     steps = found["repeats"]["page"][0]["steps"]
-    print(f"scene {args.scene}: ms per step, median of {args.repeats} (load average "
-          f"{os.getloadavg()[0]:.1f} at the end)")
+    print(f"scene {args.scene}{', the page in float' if args.single else ''}: ms per step, "
+          f"median of {args.repeats} (load average {os.getloadavg()[0]:.1f} at the end)")
     for clock, what in (("real", "real time"), ("cpu", "processor time")):
         native_runs = [r[clock] for r in found["natives"]]
         page_runs, module_runs = ([r[clock] for r in found["repeats"][w]] for w in ("page", "module"))
@@ -390,6 +414,13 @@ def main() -> None:
               f"JavaScript around it {page_ms - module_ms:+.4f} ms a step)")
         print(f"  ratio   {page_ms / native_ms:.2f} page / native; the module alone "
               f"{module_ms / native_ms:.2f}")
+        if args.single:
+            float_runs = [r[clock] for r in found["natives_float"]]
+            float_ms = statistics.median(float_runs)
+            print(f"  native  {float_ms:.4f}  of {listed(float_runs)} (clothlab run --float, one "
+                  "thread)")
+            print(f"  ratio   {page_ms / float_ms:.2f} page / native in float; the module alone "
+                  f"{module_ms / float_ms:.2f}")
     drawn = found["drawn"]
     frame_ms = drawn["ms"] / drawn["frames"]
     print(f"  frames  {frame_ms:.2f} ms per 1/60 s frame stepped and drawn with {drawn['view']} "

@@ -45,6 +45,7 @@
       return;
     }
 
+    const calm = [];  // the scenes that run without the guard stopping them
     for (const scene of page.lesson.scenes) {
       // Time advances.
       if (!page.load(scene.text, scene.name)) {
@@ -101,6 +102,7 @@
         const readable = run(`${implicit ? exact(scene.text) : scene.text}\n[engine]\nfast_path = false\n`, steps);
         const allowed = implicit ? 1e-6 : 0;
         const differ = readable.findIndex((value, k) => !(Math.abs(value - fast[k]) <= allowed));
+        calm.push(scene);
         say(`${scene.name}: the fast path and the readable path agree ${implicit ?
               'to a micrometre (implicit Euler, solves to rounding)' : 'bit for bit'}`,
             ok && api.steps() === steps && readable.length === fast.length && differ < 0,
@@ -112,6 +114,46 @@
             /blew up|guard/.test(page.message()) && api.time() > t0, page.message());
       }
     }
+
+    // Single precision in the page ([engine] precision = "float", the engine room's float room):
+    // a calm scene float covers steps in float, near its double run; a scene float does not
+    // cover is refused with what float covers. And one of them, at least, is not on its double
+    // run (a page that stepped in double whatever the scene said would give the same numbers;
+    // a single particle's drop onto the ground may, all its numbers floats).
+    const inFloat = (text) => `${text}\n[engine]\nprecision = "float"\n`;
+    let covered = 0, apart = null;
+    for (const scene of calm) {
+      if (/^\s*\[engine\]/m.test(scene.text)) continue;  // a scene that sets its engine itself
+      if (!page.load(inFloat(scene.text), scene.name)) {
+        say(`${scene.name} in float: refused, saying what float covers`,
+            /float covers .*symplectic-euler/.test(page.message()), page.message());
+        continue;
+      }
+      ++covered;
+      page.setRunning(false);
+      let ok = true;
+      for (let k = 0; k < 10 && ok; ++k) ok = page.advance(1 / 60);
+      const steps = api.steps();
+      const inSingle = page.positions();
+      page.load(scene.text, scene.name);
+      page.setRunning(false);
+      for (let k = 0; k < 600 && api.steps() < steps && ok; ++k) ok = page.advance(1 / 60);
+      const inDouble = page.positions();
+      let gap = 0, size = 1;
+      inDouble.forEach((x, k) => {
+        gap = Math.max(gap, Math.abs(x - inSingle[k]));
+        size = Math.max(size, Math.abs(x));
+      });
+      say(`${scene.name} in float: steps in single precision, near the double run`,
+          ok && steps > 0 && api.steps() === steps && inSingle.length === inDouble.length &&
+            gap <= 1e-4 * size,
+          `${steps} steps, largest difference ${gap} m (coordinates up to ${size} m); ${page.message()}`);
+      if (gap > 0) {
+        apart = `${scene.name}: ${gap} m after ${steps} steps`;
+        break;
+      }
+    }
+    if (covered > 0) say('a scene in float is not its double run', apart !== null, apart);
 
     // A slider changes the motion: the same scene, run twice for 0.6 s, once with the first
     // slider's number five times larger (or 1 if it is 0). (Long enough for lesson 09's jelly
