@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <atomic>
+#include <cmath>
 #include <stdexcept>
 
 #include "clothlab/after_step/ground_collision.hpp"
@@ -19,14 +20,19 @@ namespace {
 // Particles [begin, end) moved by their own forces in float, from the float copies (component c
 // of particle i at x[c nx + i]), into the engine's layout (x, y, z side by side, in doubles):
 // x_out and v_out the new state, f_out the forces the step summed, as the fast path leaves them.
-// A function of its own so that its pointers can be declared not to overlap: the compiler then
-// takes several particles at once.
+// Returns whether the new state is within the guard's bounds (Guard::within: |x| <= max_position,
+// |v| <= max_speed, each component, false for a NaN), tested on the values in hand as they are
+// written, where a pass of its own would read them again (the same test: a float is exactly the
+// double it is written as). A function of its own so that its pointers can be declared not to
+// overlap: the compiler then takes several particles at once.
 template <bool Symplectic>
-[[gnu::noinline]] void move_in_float(Index begin, Index end, float dt, const float* __restrict x,
+[[gnu::noinline]] bool move_in_float(Index begin, Index end, float dt, const float* __restrict x,
                                      Index nx, const float* __restrict v, Index nv,
                                      const float* __restrict f, Index nf,
                                      const double* __restrict inv_m, double* __restrict x_out,
-                                     double* __restrict v_out, double* __restrict f_out) {
+                                     double* __restrict v_out, double* __restrict f_out,
+                                     double max_position, double max_speed) {
+  long outside = 0;
   for (Index i = begin; i < end; ++i) {
     const Vec3f fi(f[i], f[nf + i], f[2 * nf + i]);
     const Vec3f xi(x[i], x[nx + i], x[2 * nx + i]);
@@ -36,11 +42,14 @@ template <bool Symplectic>
     PointStateOf<float> next = Symplectic ? symplectic_euler(xi, vi, fi, inv_mi, dt)
                                           : explicit_euler(xi, vi, fi, inv_mi, dt);
     for (int c = 0; c < 3; ++c) {
-      x_out[3 * i + c] = next.r[c];
-      v_out[3 * i + c] = next.v[c];
+      const double r = next.r[c], u = next.v[c];
+      x_out[3 * i + c] = r;
+      v_out[3 * i + c] = u;
       f_out[3 * i + c] = fi[c];
+      outside += !(std::abs(r) <= max_position) + !(std::abs(u) <= max_speed);
     }
   }
+  return outside == 0;
 }
 
 // The names of `effects` the float room does not cover, comma-separated, given what it covers.
@@ -142,9 +151,10 @@ BackendStep FloatRoom::step(World& world, double dt) {
         force.fast->add(p, c.x, c.v, c.f, b0, b1);
       for (Index c0 = b0; c0 < b1; c0 += kPassChunk) {
         const Index c1 = std::min(c0 + kPassChunk, b1);
-        move(c0, c1, h, c.x.data(), c.x.cols(), c.v.data(), c.v.cols(), c.f.data(), c.f.cols(),
-             p.inv_m.data(), p.x.data(), p.v.data(), p.f.data());
-        if (!world.guard.within(p.x, p.v, c0, c1)) end_within = false;
+        if (!move(c0, c1, h, c.x.data(), c.x.cols(), c.v.data(), c.v.cols(), c.f.data(), c.f.cols(),
+                  p.inv_m.data(), p.x.data(), p.v.data(), p.f.data(), world.guard.max_position,
+                  world.guard.max_speed))
+          end_within = false;
       }
     }
   });
