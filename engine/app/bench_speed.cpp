@@ -20,6 +20,7 @@
 //                   on 256 springs whose data stay in the first-level cache: the least any step
 //                   built on the spring kernel can cost per spring on this machine
 //   +aerodynamics   the reference with [aerodynamics] added, then [ground] as well
+//   float+aerodynamics  the float step with [aerodynamics], with its time over +aerodynamics's
 //   student         the same scene in clothlab-student (your exercises), run as a subprocess;
 //                   skipped, saying which, while an exercise it needs is still a stub
 //   implicit        implicit Euler on a stiff cloth: the whole step, then its assembly (forces,
@@ -446,34 +447,37 @@ void measure_size(int n, int all_cores, const SpeedOptions& opt, std::vector<Mea
     for (int threads : thread_counts)
       engine("reference", threads, true, "");
   }
-  if (wanted(opt, "float")) {
-    for (int threads : thread_counts) {
-      scenes.push_back(std::make_unique<Scene>(parse_scene(
-          cloth_scene(n, threads, true, "", "symplectic-euler", kKs, kDt, true, /*single=*/true),
-          "<bench>")));
-      Scene& scene = *scenes.back();
-      // How far single precision takes the cloth from the double run in 20 steps, against the
-      // distance the cloth moved: rounding's drift, not another physics.
-      Scene check = parse_scene(
-          cloth_scene(n, 1, true, "", "symplectic-euler", kKs, kDt, true, /*single=*/true),
-          "<bench>");
-      Scene reference = parse_scene(cloth_scene(n, 1, true, ""), "<bench>");
-      const Matrix3X start = reference.world.particles.x;
-      for (int k = 0; k < 20; ++k) {
-        check.world.step(check.dt);
-        reference.world.step(reference.dt);
-      }
-      const double gap =
-          (check.world.particles.x - reference.world.particles.x).cwiseAbs().maxCoeff();
-      const double moved = (reference.world.particles.x - start).cwiseAbs().maxCoeff();
-      contenders.push_back({"float",
-                            threads,
-                            spring_count(scene.world),
-                            [&scene] { scene.world.step(scene.dt); },
-                            {}});
-      notes.push_back(
-          fmt::format("{:.1e} m from reference after 20 steps (moved {:.1e} m)", gap, moved));
+  // The step in float, on `threads`, with the effects of `extra`; and how far single precision
+  // takes the cloth from the double run in 20 steps, against the distance the cloth moved:
+  // rounding's drift, not another physics.
+  const auto in_float = [&](const std::string& variant, int threads, const std::string& extra) {
+    scenes.push_back(std::make_unique<Scene>(parse_scene(
+        cloth_scene(n, threads, true, extra, "symplectic-euler", kKs, kDt, true, /*single=*/true),
+        "<bench>")));
+    Scene& scene = *scenes.back();
+    Scene check = parse_scene(
+        cloth_scene(n, 1, true, extra, "symplectic-euler", kKs, kDt, true, /*single=*/true),
+        "<bench>");
+    Scene reference = parse_scene(cloth_scene(n, 1, true, extra), "<bench>");
+    const Matrix3X start = reference.world.particles.x;
+    for (int k = 0; k < 20; ++k) {
+      check.world.step(check.dt);
+      reference.world.step(reference.dt);
     }
+    const double gap =
+        (check.world.particles.x - reference.world.particles.x).cwiseAbs().maxCoeff();
+    const double moved = (reference.world.particles.x - start).cwiseAbs().maxCoeff();
+    contenders.push_back({variant,
+                          threads,
+                          spring_count(scene.world),
+                          [&scene] { scene.world.step(scene.dt); },
+                          {}});
+    notes.push_back(
+        fmt::format("{:.1e} m from the double run after 20 steps (moved {:.1e} m)", gap, moved));
+  };
+  if (wanted(opt, "float")) {
+    for (int threads : thread_counts)
+      in_float("float", threads, "");
   }
   if (wanted(opt, "readable")) engine("readable", 1, false, "");
   NaiveCloth naive;
@@ -557,6 +561,10 @@ void measure_size(int n, int all_cores, const SpeedOptions& opt, std::vector<Mea
     for (int threads : thread_counts)
       engine("+aerodynamics+ground", threads, true, aero + ground);
   }
+  if (wanted(opt, "float+aerodynamics")) {
+    for (int threads : thread_counts)
+      in_float("float+aerodynamics", threads, aero);
+  }
   const ImplicitEuler* implicit = nullptr;
   if (wanted(opt, "implicit")) {
     // Stiff: 100 times the springs' ks, dt 4 times the scene's; explicit methods would need
@@ -576,13 +584,15 @@ void measure_size(int n, int all_cores, const SpeedOptions& opt, std::vector<Mea
     const Contender& c = contenders[k];
     rows.push_back(make_row(c.variant, n, c.threads, c.springs, median(c.samples), notes[k]));
   }
-  // The float step over the double step on as many threads, both measured in this run.
+  // A float step over its double step on as many threads, both measured in this run: float
+  // over reference, float+aerodynamics over +aerodynamics.
   for (size_t k = first_row; k < rows.size(); ++k) {
-    if (rows[k].variant != "float") continue;
+    if (rows[k].variant.rfind("float", 0) != 0) continue;
+    const std::string twin = rows[k].variant == "float" ? "reference" : rows[k].variant.substr(5);
     for (size_t r = first_row; r < rows.size(); ++r) {
-      if (rows[r].variant == "reference" && rows[r].threads == rows[k].threads) {
+      if (rows[r].variant == twin && rows[r].threads == rows[k].threads) {
         rows[k].note =
-            fmt::format("float / reference {:.2f}; {}",
+            fmt::format("{} / {} {:.2f}; {}", rows[k].variant, twin,
                         rows[k].ns_per_spring_step / rows[r].ns_per_spring_step, rows[k].note);
       }
     }
@@ -795,7 +805,8 @@ void add_bench_speed_command(CLI::App& bench) {
       speed->add_option("--variants", o.variants, "Variants to measure (default: all)")
           ->delimiter(',')
           ->check(CLI::IsMember({"reference", "float", "readable", "naive", "bare", "kernel",
-                                 "+aerodynamics", "+aerodynamics+ground", "implicit", "student"}));
+                                 "+aerodynamics", "+aerodynamics+ground", "float+aerodynamics",
+                                 "implicit", "student"}));
   speed
       ->add_flag("--float", o.single,
                  "The float rows (the step in single precision, [engine] precision = \"float\") "
