@@ -320,7 +320,8 @@ int main(int argc, char** argv) {
   run_cmd->add_flag("--float", use_float,
                     "Step in single precision in the engine room (as [engine] precision = "
                     "\"float\"): the Euler methods with gravity, springs, bending, damping, "
-                    "contacts and moving pins; close to the double run, not its bits");
+                    "aerodynamics, contacts and moving pins; close to the double run, not its "
+                    "bits");
   int threads = -1;
   run_cmd
       ->add_option("--threads", threads,
