@@ -11,8 +11,13 @@
 #pragma once
 
 #include <cmath>
+#include <type_traits>
 
 #include "clothlab/core/types.hpp"
+
+#if defined(__wasm_simd128__)
+#include <wasm_simd128.h>
+#endif
 
 namespace clothlab::fast {
 
@@ -58,6 +63,59 @@ template <class Scalar>
   }
 }
 
+#if defined(__wasm_simd128__)
+// The lesson pages' WebAssembly: to_soa_within's first particles, four at a time, by hand. Their
+// twelve components are six pairs of doubles in memory; Clang, left to it, loads them one by one
+// and rounds them to float one by one (a tenth of the page's float step). Here each pair is one
+// load and one test (|a| <= bound, lane by lane, false for a NaN, as below), and the pairs are
+// shuffled into a row each of x, y and z; into floats, each pair is rounded as one (the same
+// rounding as a conversion of each). Returns the first particle it did not take; `within` is
+// cleared if a component failed the test.
+template <class Scalar>
+Index to_soa_within_by_four(Index begin, Index end, const double* a, Scalar* s, Index stride,
+                            double bound, bool& within) {
+  const v128_t b = wasm_f64x2_splat(bound);
+  v128_t ok = wasm_i64x2_splat(-1);
+  Index i = begin;
+  for (; i + 4 <= end; i += 4) {
+    const double* p = a + 3 * i;
+    // d0 = (x0, y0), d1 = (z0, x1), d2 = (y1, z1), d3 = (x2, y2), d4 = (z2, x3), d5 = (y3, z3)
+    v128_t d[6];
+    for (int k = 0; k < 6; ++k) {
+      d[k] = wasm_v128_load(p + 2 * k);
+      ok = wasm_v128_and(ok, wasm_f64x2_le(wasm_f64x2_abs(d[k]), b));
+    }
+    Scalar* const x = s + i;
+    Scalar* const y = s + stride + i;
+    Scalar* const z = s + 2 * stride + i;
+    if constexpr (std::is_same_v<Scalar, double>) {
+      wasm_v128_store(x, wasm_i64x2_shuffle(d[0], d[1], 0, 3));
+      wasm_v128_store(x + 2, wasm_i64x2_shuffle(d[3], d[4], 0, 3));
+      wasm_v128_store(y, wasm_i64x2_shuffle(d[0], d[2], 1, 2));
+      wasm_v128_store(y + 2, wasm_i64x2_shuffle(d[3], d[5], 1, 2));
+      wasm_v128_store(z, wasm_i64x2_shuffle(d[1], d[2], 0, 3));
+      wasm_v128_store(z + 2, wasm_i64x2_shuffle(d[4], d[5], 0, 3));
+    } else {
+      static_assert(std::is_same_v<Scalar, float>);
+      v128_t f[6];  // f[k] = (d[k] rounded, 0, 0)
+      for (int k = 0; k < 6; ++k)
+        f[k] = wasm_f32x4_demote_f64x2_zero(d[k]);
+      const v128_t r0 = wasm_i32x4_shuffle(f[0], f[1], 0, 1, 4, 5);  // x0 y0 z0 x1
+      const v128_t r1 = wasm_i32x4_shuffle(f[2], f[3], 0, 1, 4, 5);  // y1 z1 x2 y2
+      const v128_t r2 = wasm_i32x4_shuffle(f[4], f[5], 0, 1, 4, 5);  // z2 x3 y3 z3
+      const v128_t xs = wasm_i32x4_shuffle(r0, r1, 0, 3, 6, 7);      // x0 x1 x2 -
+      const v128_t ys = wasm_i32x4_shuffle(r0, r1, 1, 4, 7, 7);      // y0 y1 y2 -
+      const v128_t zs = wasm_i32x4_shuffle(r0, r1, 2, 5, 5, 5);      // z0 z1 - -
+      wasm_v128_store(x, wasm_i32x4_shuffle(xs, r2, 0, 1, 2, 5));
+      wasm_v128_store(y, wasm_i32x4_shuffle(ys, r2, 0, 1, 2, 6));
+      wasm_v128_store(z, wasm_i32x4_shuffle(zs, r2, 0, 1, 4, 7));
+    }
+  }
+  if (!wasm_i64x2_all_true(ok)) within = false;
+  return i;
+}
+#endif
+
 // to_soa, and whether every component it copied is within bound: the guard's test
 // (Guard::within, |a| <= bound, false for a NaN) on the values in hand, where a pass of its own
 // would read them again. The test is on the doubles, before any rounding to float.
@@ -65,6 +123,11 @@ template <class Scalar>
 [[gnu::noinline]] bool to_soa_within(Index begin, Index end, const double* __restrict a,
                                      Scalar* __restrict s, Index stride, double bound) {
   long outside = 0;
+#if defined(__wasm_simd128__)
+  bool within = true;
+  begin = to_soa_within_by_four(begin, end, a, s, stride, bound, within);
+  outside += !within;
+#endif
   for (Index i = begin; i < end; ++i) {
     const double ax = a[3 * i], ay = a[3 * i + 1], az = a[3 * i + 2];
     s[i] = static_cast<Scalar>(ax);

@@ -121,7 +121,7 @@
     // run (a page that stepped in double whatever the scene said would give the same numbers;
     // a single particle's drop onto the ground may, all its numbers floats).
     const inFloat = (text) => `${text}\n[engine]\nprecision = "float"\n`;
-    let covered = 0, apart = null;
+    let covered = 0, apart = null, single = null;
     for (const scene of calm) {
       if (/^\s*\[engine\]/m.test(scene.text)) continue;  // a scene that sets its engine itself
       if (!page.load(inFloat(scene.text), scene.name)) {
@@ -130,6 +130,7 @@
         continue;
       }
       ++covered;
+      single = single || scene;
       page.setRunning(false);
       let ok = true;
       for (let k = 0; k < 10 && ok; ++k) ok = page.advance(1 / 60);
@@ -154,6 +155,22 @@
       }
     }
     if (covered > 0) say('a scene in float is not its double run', apart !== null, apart);
+
+    // The engine room tests the state for the guard as it copies it, before a step moves
+    // anything: a particle put far out between two steps (dragged to 1e9 m, past the guard's
+    // bound of 1e6 m) stops the next step with the guard's message for a state that was bad
+    // before the step, in double and in float (the module copies four particles at a time there).
+    const farOut = (text, name, what) => {
+      if (!page.load(text, name)) return;
+      page.setRunning(false);
+      const i = Math.min(5, api.particles() - 1);
+      const moved = api.grab(i) === 0 && api.drag(i, 1e9, 0, 0) === 0;
+      const ok = moved && page.advance(Math.max(1 / 60, api.dt()));  // a step at least
+      say(`${name} ${what}: a particle dragged to 1e9 m stops the next step before it moves`,
+          moved && !ok && /before step/.test(page.message()), page.message());
+    };
+    if (calm.length) farOut(calm[0].text, calm[0].name, 'in double');
+    if (single) farOut(inFloat(single.text), single.name, 'in float');
 
     // A slider changes the motion: the same scene, run twice for 0.6 s, once with the first
     // slider's number five times larger (or 1 if it is 0). (Long enough for lesson 09's jelly
