@@ -5,9 +5,9 @@
 // doubles: they are what the lessons teach and what the fast path calls, bit for bit the
 // readable path. A step in single precision needs the same formulas on floats, so they are
 // written here again, as templates on Scalar, each beside the equation it computes. The loops of
-// the fast path (springs.cpp) are templates on the scalar too: spring_kernel picks, for each
-// scalar, what they call: the exercise's kernel on doubles (so the double path keeps its bits
-// and its code), this file's spring_force on floats.
+// the fast path (springs.cpp, aerodynamics.cpp) are templates on the scalar too: on doubles they
+// call the exercise's kernel (so the double path keeps its bits and its code), on floats this
+// file's (spring_kernel picks for the springs' loops; aerodynamics.cpp chooses in its loop).
 #pragma once
 
 #include <cmath>
