@@ -266,16 +266,27 @@ constexpr Index kChunk = 256;  // springs per chunk: f1 of a chunk takes 6 KiB
 // the upper ends (f_upper[c n + t], if ToUpper) and the lower ends (f_lower[c n + t], if ToLower):
 // +f1 to the i end and -f1 to the j end. f_upper and f_lower point into the same array,
 // kDirectGap or more apart, which is why they are not restrict. `flatten` asks for the kernel
-// inlined at link time, as in forces_of_run: for these twelve instances GCC declines otherwise.
-template <class S, bool Uniform, bool UpperIsJ, bool ToUpper, bool ToLower>
+// inlined at link time, as in forces_of_run: for these instances GCC declines otherwise.
+//
+// Masked: one whole vector (count is kVectorLanes<S>), of which only springs t >= from add their
+// shares. Springs t < from still get their kernel, and their ends take a zero that changes
+// nothing: -0.0 added to the i end and +0.0 subtracted from the j end leave any value as it was,
+// bit for bit (+0.0 and -0.0 included, where +0.0 added would turn a -0.0 into +0.0). That is how
+// a run's last, partial vector is finished (add_run_direct): a whole vector ending at the run's
+// end, whose first lanes the vectors before it have done, in one vector pass instead of a scalar
+// loop per component.
+template <class S, bool Uniform, bool UpperIsJ, bool ToUpper, bool ToLower, bool Masked = false>
 [[gnu::noinline, gnu::flatten]] void run_kernel_direct(
     Index count, Index nx, Index nv, Index n, const S* __restrict x1, const S* __restrict x2,
     const S* __restrict v1, const S* __restrict v2, const S* __restrict ks, const S* __restrict kd,
-    const S* __restrict l0, S* f_upper, S* f_lower) {
+    const S* __restrict l0, S* f_upper, S* f_lower, Index from = 0) {
   using V = Vec3Of<S>;
-  // No two springs the compiler takes at once touch the same particle (see kDirectGap).
+  // No two springs the compiler takes at once touch the same particle (see kDirectGap). A
+  // masked pass is one whole vector, its count known here: one vector instruction a step of the
+  // kernel, where a count read at run time had GCC take the springs one at a time.
+  const Index springs = Masked ? kVectorLanes<S> : count;
   CLOTHLAB_INDEPENDENT_ITERATIONS
-  for (Index t = 0; t < count; ++t) {
+  for (Index t = 0; t < springs; ++t) {
     const V f1 =
         spring_kernel(V(x1[t], x1[nx + t], x1[2 * nx + t]), V(x2[t], x2[nx + t], x2[2 * nx + t]),
                       V(v1[t], v1[nv + t], v1[2 * nv + t]), V(v2[t], v2[nv + t], v2[2 * nv + t]),
@@ -284,6 +295,20 @@ template <class S, bool Uniform, bool UpperIsJ, bool ToUpper, bool ToLower>
     // keeps f1 in registers only if no loop index picks its components.
     S* const f_i = UpperIsJ ? f_lower : f_upper;
     S* const f_j = UpperIsJ ? f_upper : f_lower;
+    if constexpr (Masked) {
+      const bool on = t >= from;
+      if constexpr (UpperIsJ ? ToLower : ToUpper) {
+        f_i[t] += on ? f1.x() : S(-0.0);
+        f_i[n + t] += on ? f1.y() : S(-0.0);
+        f_i[2 * n + t] += on ? f1.z() : S(-0.0);
+      }
+      if constexpr (UpperIsJ ? ToUpper : ToLower) {
+        f_j[t] -= on ? f1.x() : S(0.0);
+        f_j[n + t] -= on ? f1.y() : S(0.0);
+        f_j[2 * n + t] -= on ? f1.z() : S(0.0);
+      }
+      continue;
+    }
     if constexpr (UpperIsJ ? ToLower : ToUpper) {
       f_i[t] += f1.x();
       f_i[n + t] += f1.y();
@@ -580,67 +605,56 @@ void FastSprings<S>::add_run_direct(const RunView<S>& run, Index up_begin, Index
                                     SoA& f) const {
   const Index lower = std::min(run.i0, run.j0), upper = std::max(run.i0, run.j0);
   const bool upper_is_j = run.j0 > run.i0;
-  const Index n = f.cols();
-  // Springs [t0, t1) of a run's last, partial vector, after the whole vectors before them: f1 of
-  // the last whole vector of springs, which ends at t1 (forces_in_vectors says why a lane's bits
-  // do not depend on the vector it is in), then the shares of springs t0 .. t1 - 1. Each of
-  // their ends takes one share of them, added to what the whole vectors left there.
-  const auto tail = [&](Index t0, Index t1, bool to_upper, bool to_lower) {
-    constexpr Index kLanes = kVectorLanes<S>;
-    S f1[3 * kLanes];
-    const Index first = t1 - kLanes, k = run.uniform ? 0 : first;
-    (run.uniform ? forces_of_run<S, true>
-                 : forces_of_run<S, false>)(kLanes, x.cols(), v.cols(), x.data() + run.i0 + first,
-                                            x.data() + run.j0 + first, v.data() + run.i0 + first,
-                                            v.data() + run.j0 + first, run.ks + k, run.kd + k,
-                                            run.l0 + first, f1, f1 + kLanes, f1 + 2 * kLanes);
-    // Fewer springs than kDirectGap: no particle is an end of two of them, so the i ends may
-    // take their shares before the j ends.
-    static_assert(kLanes <= kDirectGap);
-    const bool to_i = upper_is_j ? to_lower : to_upper, to_j = upper_is_j ? to_upper : to_lower;
-    for (Index c = 0; c < 3; ++c) {
-      const S* const share = f1 + c * kLanes;  // share[t - first]: spring t's
-      S* const fi = f.data() + c * n + run.i0;
-      S* const fj = f.data() + c * n + run.j0;
-      if (to_i) {
-        for (Index t = t0; t < t1; ++t)
-          fi[t] += share[t - first];
-      }
-      if (to_j) {
-        for (Index t = t0; t < t1; ++t)
-          fj[t] -= share[t - first];
-      }
-    }
-  };
-  // Springs [t0, t1) of the run, their forces added to the ends that are in range.
+  // run_kernel_direct<S, Uniform, UpperIsJ, ToUpper, ToLower, Masked> by
+  // [masked][uniform][upper_is_j][to_upper][to_lower].
+  using Kernel = decltype(&run_kernel_direct<S, false, false, true, true>);
+  static constexpr Kernel kernels[2][2][2][2][2] = {
+      {{{{nullptr, run_kernel_direct<S, false, false, false, true>},
+         {run_kernel_direct<S, false, false, true, false>,
+          run_kernel_direct<S, false, false, true, true>}},
+        {{nullptr, run_kernel_direct<S, false, true, false, true>},
+         {run_kernel_direct<S, false, true, true, false>,
+          run_kernel_direct<S, false, true, true, true>}}},
+       {{{nullptr, run_kernel_direct<S, true, false, false, true>},
+         {run_kernel_direct<S, true, false, true, false>,
+          run_kernel_direct<S, true, false, true, true>}},
+        {{nullptr, run_kernel_direct<S, true, true, false, true>},
+         {run_kernel_direct<S, true, true, true, false>,
+          run_kernel_direct<S, true, true, true, true>}}}},
+      {{{{nullptr, run_kernel_direct<S, false, false, false, true, true>},
+         {run_kernel_direct<S, false, false, true, false, true>,
+          run_kernel_direct<S, false, false, true, true, true>}},
+        {{nullptr, run_kernel_direct<S, false, true, false, true, true>},
+         {run_kernel_direct<S, false, true, true, false, true>,
+          run_kernel_direct<S, false, true, true, true, true>}}},
+       {{{nullptr, run_kernel_direct<S, true, false, false, true, true>},
+         {run_kernel_direct<S, true, false, true, false, true>,
+          run_kernel_direct<S, true, false, true, true, true>}},
+        {{nullptr, run_kernel_direct<S, true, true, false, true, true>},
+         {run_kernel_direct<S, true, true, true, false, true>,
+          run_kernel_direct<S, true, true, true, true, true>}}}}};
+  // Springs [t0, t1) of the run, their forces added to the ends that are in range: the whole
+  // vectors first; then, if the count is not a whole number of vectors, the last vector of the
+  // range once more, masked so that only the springs past the whole vectors add their shares
+  // (run_kernel_direct says why that leaves the others' sums as they were; forces_in_vectors,
+  // why a lane's f1 does not depend on the vector it is in). No particle is an end of two
+  // springs of one vector (fewer springs than kDirectGap), so the same shares in the same
+  // order as one spring at a time.
   const auto springs = [&](Index t0, Index t1, bool to_upper, bool to_lower) {
     if (t0 >= t1) return;
-    // The springs past the last whole vector, if any, are finished below (tail).
     constexpr Index kLanes = kVectorLanes<S>;
+    static_assert(kLanes <= kDirectGap);
     const Index rest = kWholeVectorEnds<S> && t1 - t0 > kLanes ? (t1 - t0) % kLanes : 0;
-    t1 -= rest;
-    const Index k = run.uniform ? 0 : t0;  // ks and kd of spring t0 (a uniform run's: of 0)
-    // run_kernel_direct<S, Uniform, UpperIsJ, ToUpper, ToLower> by
-    // [uniform][upper_is_j][to_upper][to_lower].
-    using Kernel = decltype(&run_kernel_direct<S, false, false, true, true>);
-    static constexpr Kernel kernels[2][2][2][2] = {
-        {{{nullptr, run_kernel_direct<S, false, false, false, true>},
-          {run_kernel_direct<S, false, false, true, false>,
-           run_kernel_direct<S, false, false, true, true>}},
-         {{nullptr, run_kernel_direct<S, false, true, false, true>},
-          {run_kernel_direct<S, false, true, true, false>,
-           run_kernel_direct<S, false, true, true, true>}}},
-        {{{nullptr, run_kernel_direct<S, true, false, false, true>},
-          {run_kernel_direct<S, true, false, true, false>,
-           run_kernel_direct<S, true, false, true, true>}},
-         {{nullptr, run_kernel_direct<S, true, true, false, true>},
-          {run_kernel_direct<S, true, true, true, false>,
-           run_kernel_direct<S, true, true, true, true>}}}};
-    kernels[run.uniform][upper_is_j][to_upper][to_lower](
-        t1 - t0, x.cols(), v.cols(), f.cols(), x.data() + run.i0 + t0, x.data() + run.j0 + t0,
-        v.data() + run.i0 + t0, v.data() + run.j0 + t0, run.ks + k, run.kd + k, run.l0 + t0,
-        f.data() + upper + t0, f.data() + lower + t0);
-    if (rest > 0) tail(t1, t1 + rest, to_upper, to_lower);
+    const auto run_from = [&](bool masked, Index first, Index last, Index from) {
+      const Index k = run.uniform ? 0 : first;  // ks and kd of spring first (a uniform run's: of 0)
+      kernels[masked][run.uniform][upper_is_j][to_upper][to_lower](
+          last - first, x.cols(), v.cols(), f.cols(), x.data() + run.i0 + first,
+          x.data() + run.j0 + first, v.data() + run.i0 + first, v.data() + run.j0 + first,
+          run.ks + k, run.kd + k, run.l0 + first, f.data() + upper + first,
+          f.data() + lower + first, from);
+    };
+    run_from(false, t0, t1 - rest, 0);
+    if (rest > 0) run_from(true, t1 - kLanes, t1, kLanes - rest);
   };
   // Spring t has its upper end in range for t in [up_begin, up_end) and its lower end for t in
   // [lo_begin, lo_end), the same interval shifted by the gap (or clamped to the run). In the
