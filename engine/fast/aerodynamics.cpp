@@ -23,6 +23,7 @@
 #include "clothlab/forces/aerodynamics.hpp"
 #include "fast/forces.hpp"
 #include "fast/scalar_kernels.hpp"
+#include "fast/vectorise.hpp"
 
 namespace clothlab::fast {
 
@@ -62,11 +63,26 @@ template <class S>
   }
 }
 
-// dst[i] += src[i], i = 0 .. count - 1.
+// aerodynamic_shares in whole vectors: the triangles up to the last multiple of the vector's
+// width, then the last vector's worth once more, overlapping the first part and writing there
+// again the shares it wrote (each lane's share is the kernel on its own triangle, the same
+// operations in any lane: the same bits). The compiler's remainder, one triangle at a time at a
+// lane's cost several times over, is left to groups shorter than a vector, and to builds whose
+// vectors hold two values (kWholeVectorEnds, vectorise.hpp).
 template <class S>
-void add_row(Index count, const S* __restrict src, S* __restrict dst) {
-  for (Index i = 0; i < count; ++i)
-    dst[i] += src[i];
+void shares_in_vectors(Index count, Index nx, Index nv, const S* x1, const S* x2, const S* x3,
+                       const S* v1, const S* v2, const S* v3, S* share, const Vec3Of<S>& v_air,
+                       S rho, S cd) {
+  constexpr Index kLanes = kVectorLanes<S>;
+  const Index whole = count - count % kLanes;
+  if (!kWholeVectorEnds<S> || whole == count || whole == 0) {
+    aerodynamic_shares(count, nx, nv, x1, x2, x3, v1, v2, v3, share, v_air, rho, cd);
+    return;
+  }
+  aerodynamic_shares(whole, nx, nv, x1, x2, x3, v1, v2, v3, share, v_air, rho, cd);
+  const Index t = count - kLanes;
+  aerodynamic_shares(kLanes, nx, nv, x1 + t, x2 + t, x3 + t, v1 + t, v2 + t, v3 + t, share + t,
+                     v_air, rho, cd);
 }
 
 }  // namespace
@@ -132,8 +148,8 @@ void FastAerodynamics<S>::add_triangles(size_t k_begin, size_t k_end, const SoA&
       ++count;
     }
     // Rows of `in`: x, y, z of corners 1, 2, 3, then their velocities.
-    aerodynamic_shares(count, n, n, in, in + 3 * n, in + 6 * n, in + 9 * n, in + 12 * n,
-                       in + 15 * n, share, wind(), rho(), cd());
+    shares_in_vectors(count, n, n, in, in + 3 * n, in + 6 * n, in + 9 * n, in + 12 * n, in + 15 * n,
+                      share, wind(), rho(), cd());
     for (Index q = 0; q < count; ++q) {
       for (Index corner : aero_.triangles()[chunk[q]]) {
         if (!in_range(corner)) continue;
@@ -225,9 +241,9 @@ void FastAerodynamics<S>::add_group(const TriangleGroup& g, const SoA& x, const 
     const Index i1 = std::min(i0 + n, i_end);
     for (int p = 0; p < g.period; ++p) {
       const Triangle& b = g.base[static_cast<size_t>(p)];
-      aerodynamic_shares(i1 - i0, x.cols(), v.cols(), x.data() + b[0] + i0, x.data() + b[1] + i0,
-                         x.data() + b[2] + i0, v.data() + b[0] + i0, v.data() + b[1] + i0,
-                         v.data() + b[2] + i0, share[static_cast<size_t>(p)], wind(), rho(), cd());
+      shares_in_vectors(i1 - i0, x.cols(), v.cols(), x.data() + b[0] + i0, x.data() + b[1] + i0,
+                        x.data() + b[2] + i0, v.data() + b[0] + i0, v.data() + b[1] + i0,
+                        v.data() + b[2] + i0, share[static_cast<size_t>(p)], wind(), rho(), cd());
     }
     // Every particle takes its shares in the list's order: pass by pass (see triangle_groups).
     for (size_t k = 0; k < passes; ++k) {
@@ -236,8 +252,8 @@ void FastAerodynamics<S>::add_group(const TriangleGroup& g, const SoA& x, const 
       const Index t0 = std::max(i0, begin - corner), t1 = std::min(i1, end - corner);
       if (t0 >= t1) continue;
       for (Index d = 0; d < 3; ++d) {
-        add_row(t1 - t0, share[static_cast<size_t>(p)] + d * n + (t0 - i0),
-                f.data() + d * f.cols() + corner + t0);
+        add_to_row<S, true>(t1 - t0, share[static_cast<size_t>(p)] + d * n + (t0 - i0),
+                            f.data() + d * f.cols() + corner + t0);
       }
     }
   }

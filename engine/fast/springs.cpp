@@ -200,14 +200,7 @@ template <class S, bool Uniform>
 // f1 is the kernel on that spring's own inputs, the same operations whichever lane takes it, so
 // the same bits. The compiler's own remainder (narrower vectors, then one spring at a time, each
 // at about twice the cost of a lane: SPEED.md) is never taken, except by a run shorter than one
-// vector.
-//
-// With vectors of two lanes (SSE2; WebAssembly SIMD, whose doubles the lesson pages take two at
-// a time) the remainder is one spring at most, which one more vector and a call could only cost
-// more than: there the compiler's remainder stays. (In the page, the two measured alike within
-// their spread: SPEED.md.)
-template <class S>
-constexpr bool kWholeVectorEnds = kVectorLanes<S> > 2;
+// vector, or where vectors hold two values (kWholeVectorEnds, vectorise.hpp).
 template <class S, bool Uniform>
 void forces_in_vectors(Index count, Index nx, Index nv, const S* x1, const S* x2, const S* v1,
                        const S* v2, const S* ks, const S* kd, const S* l0, S* f1x, S* f1y, S* f1z) {
@@ -324,18 +317,14 @@ template <class S, bool Uniform, bool UpperIsJ, bool ToUpper, bool ToLower, bool
 }
 
 // f[c][t] += f1[c][t] (add) or -= (subtract), for t = 0 .. count - 1 and each component c;
-// f's components are n apart, f1's kChunk apart.
+// f's components are n apart, f1's kChunk apart. In whole vectors (add_to_row, vectorise.hpp).
 template <class S>
 void add_shares(Index count, Index n, const S* __restrict f1, S* __restrict f, bool add) {
   for (int c = 0; c < 3; ++c) {
-    S* __restrict fc = f + c * n;
-    const S* __restrict f1c = f1 + c * kChunk;
     if (add) {
-      for (Index t = 0; t < count; ++t)
-        fc[t] += f1c[t];
+      add_to_row<S, true>(count, f1 + c * kChunk, f + c * n);
     } else {
-      for (Index t = 0; t < count; ++t)
-        fc[t] -= f1c[t];
+      add_to_row<S, false>(count, f1 + c * kChunk, f + c * n);
     }
   }
 }
@@ -345,21 +334,36 @@ void add_shares(Index count, Index n, const S* __restrict f1, S* __restrict f, b
 // gap], for t = 0 .. count - 1 (- then + when the upper ends are the j ends). Two passes would
 // read back, one to three places over, a value just stored by a vector instruction, which the
 // processor cannot forward from its store buffer: a stall on every load.
-template <class S>
-void add_both_shares(Index count, Index n, Index gap, const S* __restrict f1, S* __restrict f,
-                     bool upper_is_j) {
+//
+// In whole vectors, as add_to_row (vectorise.hpp): the last vector's values made from those
+// before the loop, stored after it.
+template <class S, bool UpperIsJ>
+void add_both_shares_of(Index count, Index n, Index gap, const S* __restrict f1, S* __restrict f) {
+  constexpr Index kLanes = kVectorLanes<S>;
+  const auto both = [](S fc, S up, S lo) { return UpperIsJ ? (fc - up) + lo : (fc + up) - lo; };
+  const bool tail = kWholeVectorEnds<S> && count > kLanes && count % kLanes != 0;
+  const Index last = count - kLanes, whole = count - count % kLanes;
   for (int c = 0; c < 3; ++c) {
     S* __restrict fc = f + c * n;
     const S* __restrict up = f1 + c * kChunk;
     const S* __restrict lo = up + gap;
-    if (upper_is_j) {
+    if (!tail) {
       for (Index t = 0; t < count; ++t)
-        fc[t] = (fc[t] - up[t]) + lo[t];
-    } else {
-      for (Index t = 0; t < count; ++t)
-        fc[t] = (fc[t] + up[t]) - lo[t];
+        fc[t] = both(fc[t], up[t], lo[t]);
+      continue;
     }
+    S end[kLanes];
+    for (Index l = 0; l < kLanes; ++l)
+      end[l] = both(fc[last + l], up[last + l], lo[last + l]);
+    for (Index t = 0; t < whole; ++t)
+      fc[t] = both(fc[t], up[t], lo[t]);
+    for (Index l = 0; l < kLanes; ++l)
+      fc[last + l] = end[l];
   }
+}
+template <class S>
+void add_both_shares(Index count, Index n, Index gap, const S* f1, S* f, bool upper_is_j) {
+  (upper_is_j ? add_both_shares_of<S, true> : add_both_shares_of<S, false>)(count, n, gap, f1, f);
 }
 
 }  // namespace
