@@ -114,6 +114,44 @@ Index to_soa_within_by_four(Index begin, Index end, const double* a, Scalar* s, 
   if (!wasm_i64x2_all_true(ok)) within = false;
   return i;
 }
+
+// The reverse, for the float room's move in the lesson pages (float_room.cpp): rows x, y and z of
+// floats, particles 0 .. count - 1, into a (the engine's layout, x, y, z side by side) in
+// doubles, four particles at a time. Each row's floats are widened a pair at a time (a float is
+// exactly the double it is written as) and the pairs shuffled into the layout's order: six
+// stores of two doubles where Clang, left to it, stored twelve one by one. With Test, each pair
+// is tested as it is stored (|a| <= bound, lane by lane, false for a NaN: Guard::within's test)
+// and `within` is cleared if one fails. Returns the first particle it did not take.
+template <bool Test>
+Index from_float_rows_by_four(Index count, const float* x, const float* y, const float* z,
+                              double* a, double bound, bool& within) {
+  const v128_t b = wasm_f64x2_splat(bound);
+  v128_t ok = wasm_i64x2_splat(-1);
+  Index i = 0;
+  for (; i + 4 <= count; i += 4) {
+    const v128_t xs = wasm_v128_load(x + i), ys = wasm_v128_load(y + i), zs = wasm_v128_load(z + i);
+    // Each row's four floats as two pairs of doubles: (x0, x1), (x2, x3), ...
+    const v128_t x01 = wasm_f64x2_promote_low_f32x4(xs);
+    const v128_t x23 = wasm_f64x2_promote_low_f32x4(wasm_i32x4_shuffle(xs, xs, 2, 3, 2, 3));
+    const v128_t y01 = wasm_f64x2_promote_low_f32x4(ys);
+    const v128_t y23 = wasm_f64x2_promote_low_f32x4(wasm_i32x4_shuffle(ys, ys, 2, 3, 2, 3));
+    const v128_t z01 = wasm_f64x2_promote_low_f32x4(zs);
+    const v128_t z23 = wasm_f64x2_promote_low_f32x4(wasm_i32x4_shuffle(zs, zs, 2, 3, 2, 3));
+    if constexpr (Test) {
+      for (const v128_t d : {x01, x23, y01, y23, z01, z23})
+        ok = wasm_v128_and(ok, wasm_f64x2_le(wasm_f64x2_abs(d), b));
+    }
+    double* const p = a + 3 * i;
+    wasm_v128_store(p, wasm_i64x2_shuffle(x01, y01, 0, 2));       // x0 y0
+    wasm_v128_store(p + 2, wasm_i64x2_shuffle(z01, x01, 0, 3));   // z0 x1
+    wasm_v128_store(p + 4, wasm_i64x2_shuffle(y01, z01, 1, 3));   // y1 z1
+    wasm_v128_store(p + 6, wasm_i64x2_shuffle(x23, y23, 0, 2));   // x2 y2
+    wasm_v128_store(p + 8, wasm_i64x2_shuffle(z23, x23, 0, 3));   // z2 x3
+    wasm_v128_store(p + 10, wasm_i64x2_shuffle(y23, z23, 1, 3));  // y3 z3
+  }
+  if (Test && !wasm_i64x2_all_true(ok)) within = false;
+  return i;
+}
 #endif
 
 // to_soa, and whether every component it copied is within bound: the guard's test

@@ -33,22 +33,62 @@ template <bool Symplectic>
                                      double* __restrict v_out, double* __restrict f_out,
                                      double max_position, double max_speed) {
   long outside = 0;
-  for (Index i = begin; i < end; ++i) {
+  // Particle i moved by its own force, in float.
+  const auto next_of = [&](Index i) {
     const Vec3f fi(f[i], f[nf + i], f[2 * nf + i]);
     const Vec3f xi(x[i], x[nx + i], x[2 * nx + i]);
     const Vec3f vi(v[i], v[nv + i], v[2 * nv + i]);
     const float inv_mi = static_cast<float>(inv_m[i]);
+    return Symplectic ? symplectic_euler(xi, vi, fi, inv_mi, dt)
+                      : explicit_euler(xi, vi, fi, inv_mi, dt);
+  };
+#if defined(__wasm_simd128__)
+  // The lesson pages' WebAssembly: the new state of up to kPassChunk particles in float rows
+  // first (the loop below without its stores into doubles, which Clang vectorises), then into
+  // the engine's doubles four particles at a time by hand, tested as they go, f with them
+  // (from_float_rows_by_four, copies.hpp). The same numbers, the same test.
+  float next_r[3][kPassChunk], next_v[3][kPassChunk];
+  for (Index c0 = begin; c0 < end; c0 += kPassChunk) {
+    const Index count = std::min(kPassChunk, end - c0);
+    for (Index k = 0; k < count; ++k) {
+      PointStateOf<float> next = next_of(c0 + k);
+      for (int c = 0; c < 3; ++c) {
+        next_r[c][k] = next.r[c];
+        next_v[c][k] = next.v[c];
+      }
+    }
+    bool within = true;
+    const Index by_four = from_float_rows_by_four<true>(count, next_r[0], next_r[1], next_r[2],
+                                                        x_out + 3 * c0, max_position, within);
+    from_float_rows_by_four<true>(count, next_v[0], next_v[1], next_v[2], v_out + 3 * c0, max_speed,
+                                  within);
+    from_float_rows_by_four<false>(count, f + c0, f + nf + c0, f + 2 * nf + c0, f_out + 3 * c0, 0.0,
+                                   within);
+    outside += !within;
+    for (Index k = by_four; k < count; ++k) {
+      const Index i = c0 + k;
+      for (int c = 0; c < 3; ++c) {
+        const double r = next_r[c][k], u = next_v[c][k];
+        x_out[3 * i + c] = r;
+        v_out[3 * i + c] = u;
+        f_out[3 * i + c] = f[c * nf + i];
+        outside += !(std::abs(r) <= max_position) + !(std::abs(u) <= max_speed);
+      }
+    }
+  }
+#else
+  for (Index i = begin; i < end; ++i) {
     // Not const, as in the fast path's move: GCC 12 does not split a const aggregate.
-    PointStateOf<float> next = Symplectic ? symplectic_euler(xi, vi, fi, inv_mi, dt)
-                                          : explicit_euler(xi, vi, fi, inv_mi, dt);
+    PointStateOf<float> next = next_of(i);
     for (int c = 0; c < 3; ++c) {
       const double r = next.r[c], u = next.v[c];
       x_out[3 * i + c] = r;
       v_out[3 * i + c] = u;
-      f_out[3 * i + c] = fi[c];
+      f_out[3 * i + c] = f[c * nf + i];
       outside += !(std::abs(r) <= max_position) + !(std::abs(u) <= max_speed);
     }
   }
+#endif
   return outside == 0;
 }
 
