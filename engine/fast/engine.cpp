@@ -123,7 +123,7 @@ bool FastEngine::potential_energy(const World& world, const ForceEffect& effect,
     if (effects[e].get() != &effect) continue;
     Force& force = forces_[e];
     force.match(effect, fast_force);
-    return force.fast && force.fast->potential_energy(world.particles, x, energy);
+    return force.fast && force.fast->potential_energy(world, x, energy);
   }
   return false;
 }

@@ -42,8 +42,9 @@ class FastForceOf {
   virtual size_t stencil_springs() const { return 0; }
 
   // The effect's potential energy at x (the engine's layout), as its own potential_energy
-  // computes it, bit for bit (Backend::potential_energy). False: declined.
-  virtual bool potential_energy(const Particles& /*p*/, const Matrix3X& /*x*/, double& /*energy*/) {
+  // computes it, bit for bit (Backend::potential_energy), on the world's threads where it can
+  // split the work. False: declined.
+  virtual bool potential_energy(const World& /*world*/, const Matrix3X& /*x*/, double& /*energy*/) {
     return false;
   }
 };

@@ -40,6 +40,7 @@
 #include <array>
 #include <type_traits>
 
+#include "clothlab/core/world.hpp"
 #include "fast/forces.hpp"
 #include "fast/scalar_kernels.hpp"
 #include "fast/vectorise.hpp"
@@ -432,19 +433,30 @@ class FastSprings final : public FastForceOf<S> {
 
   // The springs' energy as SpringDampers::potential_energy sums it: each spring's energy in
   // the set's order, added one after the other. The energies come run by run, several springs
-  // an instruction (energies_of_run), into energies_; the sum then reads them in order, so the
-  // bits are the same. On doubles only: the energies the guard checks are the engine's.
-  bool potential_energy(const Particles& p, const Matrix3X& x, double& energy) override {
+  // an instruction (energies_of_run), into energies_, each thread of the world the springs of
+  // its own range of the set (a run cut where a range ends: each spring's energy is the same
+  // bits in any lane); the sum then reads them in order, on this thread, so the bits are the
+  // same. On doubles only: the energies the guard checks are the engine's.
+  bool potential_energy(const World& world, const Matrix3X& x, double& energy) override {
     if constexpr (!std::is_same_v<S, double>) {
       return false;
     } else {
-      if (!prepare(p)) return false;  // runs too short to pay: the effect's own loop
+      if (!prepare(world.particles)) return false;  // runs too short to pay: the effect's loop
       const SpringSet& s = springs_.springs();
       energies_.resize(s.size());
-      for (const SpringRun& run : runs_) {
-        energies_of_run(run.length, x.data() + 3 * run.i0, x.data() + 3 * run.j0,
-                        s.ks().data() + run.k0, s.l0().data() + run.k0, energies_.data() + run.k0);
-      }
+      world.for_items(static_cast<Index>(s.size()), [&](Index begin, Index end) {
+        // The runs cover the set in its order: the first that ends after `begin`, and on.
+        auto run = std::partition_point(runs_.begin(), runs_.end(), [&](const SpringRun& r) {
+          return static_cast<Index>(r.k0) + r.length <= begin;
+        });
+        for (; run != runs_.end() && static_cast<Index>(run->k0) < end; ++run) {
+          const Index k0 = std::max(begin, static_cast<Index>(run->k0));
+          const Index k1 = std::min(end, static_cast<Index>(run->k0) + run->length);
+          const Index t = k0 - static_cast<Index>(run->k0);  // the first spring, along the run
+          energies_of_run(k1 - k0, x.data() + 3 * (run->i0 + t), x.data() + 3 * (run->j0 + t),
+                          s.ks().data() + k0, s.l0().data() + k0, energies_.data() + k0);
+        }
+      });
       double sum = 0.0;
       for (const double e : energies_)
         sum += e;

@@ -273,6 +273,23 @@ TEST_CASE("guard: a falling or bouncing particle has its fall as energy scale") 
         doctest::Approx(9.8 * (0.5 * 9.8 * t * t - 0.5 * 9.8 * 0.002 * t)).epsilon(1e-9));
 }
 
+TEST_CASE("guard: a field added after the start releases energy from where the run started") {
+  // The guard keeps each field's energy at the start; gravity switched on after the first step
+  // has none kept, and its release is measured from the start's positions all the same.
+  World world;
+  world.particles.add(Vec3(0.0, 100.0, 0.0), Vec3::Zero(), 1.0);
+  world.integrator = clothlab::make_integrator("explicit-euler");
+  world.step(0.002);  // the start: nothing acts, nothing moves
+  world.force_effects.push_back(std::make_unique<clothlab::UniformGravity>(Vec3(0, -9.8, 0)));
+  for (int s = 1; s < 2000; ++s)
+    world.step(0.002);
+  // At the last check (step 1984) gravity has acted for n = 1983 steps: explicit Euler's drop
+  // g dt^2 n (n - 1) / 2 from the start's 100 m, times m g.
+  const double n = 1983, dt = 0.002;
+  CHECK(world.guard.energy_scale() ==
+        doctest::Approx(9.8 * 9.8 * dt * dt * n * (n - 1) / 2).epsilon(1e-9));
+}
+
 TEST_CASE("guard: the energy check leaves a damped, driven or falling scene alone") {
   // A flag in a strong wind under gravity for 4 s: energy grows (the wind does work) but stays
   // within the scene's energy scale.

@@ -509,7 +509,8 @@ TEST_CASE("fast path: tearing and plasticity on the runs layout match the readab
 
 TEST_CASE("fast path: the springs' potential energy is the readable path's, bit for bit") {
   // The guard's energy check sums it every 32 steps. The engine room computes the springs'
-  // energies run by run, several at once, and adds them up in the set's order.
+  // energies run by run, several at once, each thread those of its range of the set (runs cut
+  // where the ranges meet), and adds them up in the set's order: the same bits on 1 to 4 threads.
   std::string torn = cloth(
       "[plasticity]\nyield_strain = 0.02\nmax_strain = 0.4\n[tearing]\n"
       "strain = 0.08\n",
@@ -539,6 +540,14 @@ TEST_CASE("fast path: the springs' potential energy is the readable path's, bit 
       ++taken;
       CHECK(own > 0.0);  // the springs are stretched: the test compares something
       CHECK(bits(fast) == bits(own));
+      for (int threads : {2, 3, 4}) {
+        CAPTURE(threads);
+        world.threads = threads;
+        double threaded = 0.0;
+        CHECK(world.backend->potential_energy(world, *effect, world.particles.x, threaded));
+        CHECK(bits(threaded) == bits(own));
+      }
+      world.threads = 1;
     }
     CHECK(taken == expected);
     // The world's sum, with the backend and without it.
@@ -863,7 +872,8 @@ TEST_CASE("fast path: a job's threads meet at sync(), and a throw there leaves n
 
 TEST_CASE("fast path: an Euler step wakes the threads once, and so does a force sum") {
   // The copy into the fast layout and the pass that sums and moves are one job of the threads,
-  // with a barrier inside it (FastEngine::pass): each step wakes them once. Buoyancy (no fast
+  // with a barrier inside it (FastEngine::pass): each step wakes them once, and the guard's
+  // energy check (every 32 steps) once more, for the springs' energies. Buoyancy (no fast
   // form) is taken out, so that every effect has one; the ground rides along in the pass.
   const auto no_buoyancy = [](clothlab::World& w) {
     std::erase_if(w.force_effects, [](const auto& e) { return e->name() == "buoyancy"; });
@@ -874,11 +884,12 @@ TEST_CASE("fast path: an Euler step wakes the threads once, and so does a force 
       CAPTURE(threads);
       clothlab::Scene scene = run(cloth("", method), true, threads, 1, no_buoyancy);
       REQUIRE(engine_of(scene.world).plan().ends_with("drag+"));
+      constexpr int kSteps = 40;  // past an energy check
+      const long checks = test::energy_check_wakes(scene.world, scene.world.steps, kSteps);
       const long before = scene.world.thread_wakes();
-      constexpr int kSteps = 40;  // past an energy check (every 32 steps), which wakes nobody
       for (int s = 0; s < kSteps; ++s)
         scene.world.step(scene.dt);
-      CHECK(scene.world.thread_wakes() - before == kSteps);
+      CHECK(scene.world.thread_wakes() - before == kSteps + checks);
       // A force sum alone (what a multi-stage method asks for): the copy, the sum and the
       // forces copied back in one job too.
       clothlab::Matrix3X f;

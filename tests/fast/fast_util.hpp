@@ -53,6 +53,25 @@ inline bool identical(const clothlab::Matrix3X& a, const clothlab::Matrix3X& b) 
   return a.cols() == b.cols() && (a.array() == b.array()).all();
 }
 
+// The threads' wakes the guard's energy checks add to `steps` steps that start after step
+// `start`: one per check for each force effect whose energy the engine room computes on the
+// threads (each spring set it takes). Counted on one thread, so that counting wakes nobody.
+inline long energy_check_wakes(clothlab::World& world, long start, long steps) {
+  const int threads = world.threads;
+  world.threads = 1;
+  long taken = 0;
+  for (const auto& effect : world.force_effects) {
+    double energy = 0.0;
+    taken += world.backend->potential_energy(world, *effect, world.particles.x, energy);
+  }
+  world.threads = threads;
+  const long every = world.guard.energy_check_every;
+  const long checks = (start + steps) / every - start / every;
+  REQUIRE(checks >= 1);  // the steps reach a check: the count is tested
+  REQUIRE(taken >= 1);
+  return checks * taken;
+}
+
 // The world's fast engine (a scene installs one unless it says fast_path = false).
 inline clothlab::fast::FastEngine& engine_of(const clothlab::World& world) {
   auto* engine = dynamic_cast<clothlab::fast::FastEngine*>(world.backend.get());

@@ -67,14 +67,12 @@ class ForceEffect {
     return std::abs(potential_energy(p, x));
   }
 
-  // The energy [J] an external field (gravity, gravitation, buoyancy) has released between
-  // positions x0 and x, |U(x) - U(x0)|: a ball that has fallen far has that much energy to
-  // show for it. Springs and other internal forces release none: their energy is what a
-  // runaway shows up in. The guard widens its yardstick by the most released so far.
-  virtual double released_energy(const Particles& /*p*/, const Matrix3X& /*x0*/,
-                                 const Matrix3X& /*x*/) const {
-    return 0.0;
-  }
+  // Whether this is an external field (gravity, gravitation, buoyancy): between positions x0
+  // and x it has released |U(x) - U(x0)| [J] of energy, and a ball that has fallen far has that
+  // much to show for it. Springs and other internal forces release none: their energy is what a
+  // runaway shows up in. The guard widens its yardstick by the most released so far (it keeps
+  // U(x0) from the start and takes U(x) from the energy it checks).
+  virtual bool external_field() const { return false; }
 
   // Adds this effect's force Jacobians at (x, v) for the implicit integrator. An effect that
   // adds none (gravity, wind) is treated explicitly: its force enters the step, its Jacobian

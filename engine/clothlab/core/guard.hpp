@@ -9,11 +9,13 @@
 
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 #include "clothlab/core/types.hpp"
 
 namespace clothlab {
 
+class ForceEffect;
 class World;
 
 class SimulationError : public std::runtime_error {
@@ -68,9 +70,16 @@ struct Guard {
   double energy_scale() const { return energy_scale_ + released_; }
 
  private:
-  double energy_start_ = 0.0;    // [J]
-  double energy_scale_ = 0.0;    // [J] at the start
-  Matrix3X x_start_;             // positions at the start [m]
+  double energy_start_ = 0.0;  // [J]
+  double energy_scale_ = 0.0;  // [J] at the start
+  Matrix3X x_start_;           // positions at the start [m]
+  // Each external field's potential energy at the start [J], the field at its place in the
+  // world's list (ForceEffect::external_field).
+  struct FieldStart {
+    const ForceEffect* field;
+    double energy;
+  };
+  std::vector<FieldStart> field_start_;
   mutable double released_ = 0;  // [J] the most energy external fields have released so far
 };
 

@@ -93,7 +93,10 @@ class World {
   // Diagnostics of the current state.
   double kinetic_energy() const;    // sum of 1/2 m |v|^2 [J] (pinned particles do not move)
   double potential_energy() const;  // sum over force effects [J]
-  Vec3 momentum() const;            // sum of m v [kg m/s]
+  // One force effect's potential energy at the current state [J]: the backend's when it
+  // computes it (the same bits), else the effect's own. potential_energy() adds these up.
+  double potential_energy_of(const ForceEffect& effect) const;
+  Vec3 momentum() const;  // sum of m v [kg m/s]
 
   // "gravity, gravitation; symplectic-euler": what a report or an error names as in play.
   std::string effects_in_play() const;

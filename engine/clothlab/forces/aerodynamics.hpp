@@ -124,9 +124,7 @@ class Buoyancy final : public ForceEffect {
   // h = x . up is the particle's height, and 0 above: a particle held under stores the energy
   // the fluid would give it rising to the surface, so -dU/dh = rho V |g| is the lift.
   double potential_energy(const Particles& p, const Matrix3X& x) const override;
-  double released_energy(const Particles& p, const Matrix3X& x0, const Matrix3X& x) const override {
-    return std::abs(potential_energy(p, x) - potential_energy(p, x0));
-  }
+  bool external_field() const override { return true; }
   // rho V g size for every particle: what rising through the scene's size can release.
   double energy_scale(const Particles& p, const Matrix3X& /*x*/, double size) const override {
     return static_cast<double>(p.size()) * rho_ * volume_ * g_ * size;

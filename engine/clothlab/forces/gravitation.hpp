@@ -25,9 +25,7 @@ class Gravitation final : public ForceEffect {
                   Matrix3X& f) const override;
   // U = -sum over pairs of G m_i m_j / r_ij.
   double potential_energy(const Particles& p, const Matrix3X& x) const override;
-  double released_energy(const Particles& p, const Matrix3X& x0, const Matrix3X& x) const override {
-    return std::abs(potential_energy(p, x) - potential_energy(p, x0));
-  }
+  bool external_field() const override { return true; }
   double G() const { return G_; }
 
  private:

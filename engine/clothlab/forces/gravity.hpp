@@ -22,9 +22,7 @@ class UniformGravity final : public ForceEffect {
   double potential_energy(const Particles& p, const Matrix3X& x) const override;
   // M |g| size: what falling the scene's size releases (U itself depends on the origin).
   double energy_scale(const Particles& p, const Matrix3X& x, double size) const override;
-  double released_energy(const Particles& p, const Matrix3X& x0, const Matrix3X& x) const override {
-    return std::abs(potential_energy(p, x) - potential_energy(p, x0));
-  }
+  bool external_field() const override { return true; }
   const Vec3& g() const { return g_; }
 
  private:
