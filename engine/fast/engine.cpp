@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <atomic>
+#include <cmath>
 
 #include "clothlab/after_step/ground_collision.hpp"
 #include "clothlab/core/world.hpp"
@@ -27,27 +28,35 @@ template <class Kernel>
 // The same moves, the kernel's inputs read from the copies, where component c of particle i
 // sits at x[c nx + i]: the compiler then takes several particles at once with vector
 // instructions, which the loop above, on x, y and z side by side, does not allow. The same
-// operations on the same values: the same bits. The pointers are declared not to overlap (the
-// outputs are the particles' own x and v, the inputs the copies), so the function is kept out
-// of line.
-template <class Kernel>
-[[gnu::noinline, gnu::flatten]] void move_particles_from_copies(
+// operations on the same values: the same bits. The forces go to the engine's layout (f_out)
+// with the new state, and when `Check`, the new state is tested against the guard's bounds on
+// the values in hand as they are written, where a pass of its own would read them again
+// (Guard::within's test: |x| <= max_position, |v| <= max_speed, each component, false for a
+// NaN); the result is whether all are within. The pointers are declared not to overlap (the
+// outputs are the particles' own x, v and f, the inputs the copies), so the function is kept
+// out of line.
+template <bool Check, class Kernel>
+[[gnu::noinline, gnu::flatten]] bool move_particles_from_copies(
     Index begin, Index end, double dt, Kernel kernel, const double* __restrict x, Index nx,
     const double* __restrict v, Index nv, const double* __restrict f, Index nf,
-    const double* __restrict inv_m, double* __restrict x_out, double* __restrict v_out) {
+    const double* __restrict inv_m, double* __restrict x_out, double* __restrict v_out,
+    double* __restrict f_out, double max_position, double max_speed) {
+  long outside = 0;
   for (Index i = begin; i < end; ++i) {
     // Not const: GCC 12 does not split a const aggregate into its six doubles, and the loop
     // then goes one particle at a time through the stack (three times slower).
     PointState next =
         kernel(Vec3(x[i], x[nx + i], x[2 * nx + i]), Vec3(v[i], v[nv + i], v[2 * nv + i]),
                Vec3(f[i], f[nf + i], f[2 * nf + i]), inv_m[i], dt);
-    x_out[3 * i] = next.r.x();
-    x_out[3 * i + 1] = next.r.y();
-    x_out[3 * i + 2] = next.r.z();
-    v_out[3 * i] = next.v.x();
-    v_out[3 * i + 1] = next.v.y();
-    v_out[3 * i + 2] = next.v.z();
+    for (int c = 0; c < 3; ++c) {
+      x_out[3 * i + c] = next.r[c];
+      v_out[3 * i + c] = next.v[c];
+      f_out[3 * i + c] = f[c * nf + i];
+      if constexpr (Check)
+        outside += !(std::abs(next.r[c]) <= max_position) + !(std::abs(next.v[c]) <= max_speed);
+    }
   }
+  return outside == 0;
 }
 
 // A contact's response on particles [begin, end), the lecture's loop (Ground::collide,
@@ -65,14 +74,17 @@ template <class Collider>
 // loop is compiled for its kernel, inlined.
 template <class Kernel>
 FastEngine::MoveRange euler_move(Particles& p, double dt, Kernel kernel) {
-  return [&p, dt, kernel](Index begin, Index end, const Copies* copies) {
+  return [&p, dt, kernel](Index begin, Index end, const Copies* copies, const Guard* guard) {
     if (!copies) {
       move_particles(p, begin, end, dt, kernel);
-      return;
+      return !guard || guard->within(p.x, p.v, begin, end);
     }
-    move_particles_from_copies(begin, end, dt, kernel, copies->x.data(), copies->x.cols(),
-                               copies->v.data(), copies->v.cols(), copies->f.data(),
-                               copies->f.cols(), p.inv_m.data(), p.x.data(), p.v.data());
+    const auto move = guard ? move_particles_from_copies<true, Kernel>
+                            : move_particles_from_copies<false, Kernel>;
+    return move(begin, end, dt, kernel, copies->x.data(), copies->x.cols(), copies->v.data(),
+                copies->v.cols(), copies->f.data(), copies->f.cols(), p.inv_m.data(), p.x.data(),
+                p.v.data(), p.f.data(), guard ? guard->max_position : 0.0,
+                guard ? guard->max_speed : 0.0);
   };
 }
 
@@ -165,12 +177,14 @@ BackendStep FastEngine::step(World& world, double dt) {
   MoveRange move_then_contacts;
   const MoveRange* moves = &move;
   if (!contacts_.empty()) {
-    move_then_contacts = [&](Index begin, Index end, const Copies* copies) {
-      move(begin, end, copies);
+    // The guard's test after the contacts, on the state they leave.
+    move_then_contacts = [&](Index begin, Index end, const Copies* copies, const Guard* guard) {
+      move(begin, end, copies, nullptr);
       for (const Contact& contact : contacts_) {
         if (contact.ground) collide_range(*contact.ground, p, begin, end);
         if (contact.sphere) collide_range(*contact.sphere, p, begin, end);
       }
+      return !guard || guard->within(p.x, p.v, begin, end);
     };
     moves = &move_then_contacts;
   }
@@ -214,9 +228,7 @@ void FastEngine::pass(const World& world, const Matrix3X& x, const Matrix3X& v, 
         force.fast->add(p, c.x, c.v, c.f, b0, b1);
       for (Index c0 = b0; c0 < b1; c0 += kPassChunk) {
         const Index c1 = std::min(c0 + kPassChunk, b1);
-        from_soa(c0, c1, c.f.data(), c.f.cols(), f.data());
-        (*move)(c0, c1, &c);
-        if (check_end && !world.guard.within(p.x, p.v, c0, c1)) end_within = false;
+        if (!(*move)(c0, c1, &c, check_end ? &world.guard : nullptr)) end_within = false;
       }
     }
   };
@@ -285,7 +297,9 @@ void FastEngine::pass(const World& world, const Matrix3X& x, const Matrix3X& v, 
     e = last;
   }
   if (in_soa) move_f(false);
-  if (move) world.for_particles([&](Index begin, Index end) { (*move)(begin, end, nullptr); });
+  if (move) {
+    world.for_particles([&](Index begin, Index end) { (*move)(begin, end, nullptr, nullptr); });
+  }
 }
 
 std::unique_ptr<Backend> make_fast_engine() {

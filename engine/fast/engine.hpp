@@ -63,6 +63,7 @@
 namespace clothlab {
 class Ground;
 class Sphere;
+struct Guard;
 }  // namespace clothlab
 
 namespace clothlab::fast {
@@ -143,9 +144,14 @@ class FastEngine final : public Backend {
   size_t stencil_springs() const;
 
   // An update of particles [begin, end) after their forces are summed: it may read f and change
-  // the state of those particles only. With `copies`, the copies hold, for those particles, the
-  // same x, v and f as the engine's layout, bit for bit, and the update may read them instead.
-  using MoveRange = std::function<void(Index begin, Index end, const Copies* copies)>;
+  // the state of those particles only. Without `copies`, it reads them in the engine's layout.
+  // With `copies`, the copies hold, for those particles, the same x and v as the engine's
+  // layout, bit for bit, and the forces just summed, which the update reads there and also
+  // writes into the engine's f as it goes (the forces' copy back). With `guard`, it returns
+  // whether the new state of those particles is within the guard's bounds (Guard::within);
+  // without, true.
+  using MoveRange =
+      std::function<bool(Index begin, Index end, const Copies* copies, const Guard* guard)>;
 
  private:
   // The guard's checks a step's one pass takes on (step).
