@@ -107,12 +107,11 @@ void Guard::check(const World& world, bool before_step) const {
 
 void Guard::start(const World& world) {
   const Particles& p = world.particles;
-  energy_start_ = world.kinetic_energy() + world.potential_energy();
-  field_start_.clear();
-  for (const auto& effect : world.force_effects) {
-    field_start_.push_back(
-        {effect.get(), effect->external_field() ? world.potential_energy_of(*effect) : 0.0});
-  }
+  std::vector<double> potentials;
+  energy_start_ = world.kinetic_energy() + world.potential_energy(&potentials);
+  effect_start_.clear();
+  for (size_t e = 0; e < world.force_effects.size(); ++e)
+    effect_start_.push_back({world.force_effects[e].get(), potentials[e]});
   double size = 0.0;
   if (p.size() > 0) size = (p.x.rowwise().maxCoeff() - p.x.rowwise().minCoeff()).norm();
   energy_scale_ = world.kinetic_energy();
@@ -126,22 +125,21 @@ void Guard::start(const World& world) {
 
 void Guard::check_energy(const World& world) const {
   const Particles& p = world.particles;
-  // The potential energy as World::potential_energy sums it, each effect's term kept for what
-  // the fields have released: |U(x) - U(x_start)|, U(x_start) as start() found it if the field
-  // is still at its place in the list, else computed now.
-  const bool same_particles = x_start_.cols() == p.size();
-  double potential = 0.0, released = 0.0;
-  for (size_t e = 0; e < world.force_effects.size(); ++e) {
-    const ForceEffect& effect = *world.force_effects[e];
-    const double u = world.potential_energy_of(effect);
-    potential += u;
-    if (!same_particles || !effect.external_field()) continue;
-    const bool kept = e < field_start_.size() && field_start_[e].field == &effect;
-    released +=
-        std::abs(u - (kept ? field_start_[e].energy : effect.potential_energy(p, x_start_)));
+  // Each effect's term kept for what the fields have released: |U(x) - U(x_start)|, U(x_start)
+  // as start() found it if the field is still at its place in the list, else computed now.
+  std::vector<double> potentials;
+  const double energy = world.kinetic_energy() + world.potential_energy(&potentials);
+  if (x_start_.cols() == p.size()) {
+    double released = 0.0;
+    for (size_t e = 0; e < world.force_effects.size(); ++e) {
+      const ForceEffect& effect = *world.force_effects[e];
+      if (!effect.external_field()) continue;
+      const bool kept = e < effect_start_.size() && effect_start_[e].effect == &effect;
+      released += std::abs(potentials[e] -
+                           (kept ? effect_start_[e].energy : effect.potential_energy(p, x_start_)));
+    }
+    released_ = std::max(released_, released);
   }
-  if (same_particles) released_ = std::max(released_, released);
-  const double energy = world.kinetic_energy() + potential;
   const double allowed = max_energy_growth * energy_scale();
   // !(gain <= allowed) also catches a NaN energy.
   if (energy - energy_start_ <= allowed) return;

@@ -73,13 +73,14 @@ struct Guard {
   double energy_start_ = 0.0;  // [J]
   double energy_scale_ = 0.0;  // [J] at the start
   Matrix3X x_start_;           // positions at the start [m]
-  // Each external field's potential energy at the start [J], the field at its place in the
-  // world's list (ForceEffect::external_field).
-  struct FieldStart {
-    const ForceEffect* field;
+  // Each force effect's potential energy at the start [J], the effect at its place in the
+  // world's list: the external fields' released energy is measured from it
+  // (ForceEffect::external_field).
+  struct EffectStart {
+    const ForceEffect* effect;
     double energy;
   };
-  std::vector<FieldStart> field_start_;
+  std::vector<EffectStart> effect_start_;
   mutable double released_ = 0;  // [J] the most energy external fields have released so far
 };
 

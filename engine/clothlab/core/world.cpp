@@ -84,18 +84,17 @@ double World::kinetic_energy() const {
   return 0.5 * particles.m.dot(particles.v.colwise().squaredNorm().transpose());
 }
 
-double World::potential_energy_of(const ForceEffect& effect) const {
-  // The backend may compute an effect's energy faster, to the same bits (backend.hpp).
-  double e = 0.0;
-  if (!backend || !backend->potential_energy(*this, effect, particles.x, e))
-    e = effect.potential_energy(particles, particles.x);
-  return e;
-}
-
-double World::potential_energy() const {
+double World::potential_energy(std::vector<double>* each) const {
+  if (each) each->clear();
   double energy = 0.0;
-  for (const auto& effect : force_effects)
-    energy += potential_energy_of(*effect);
+  for (const auto& effect : force_effects) {
+    // The backend may compute an effect's energy faster, to the same bits (backend.hpp).
+    double e = 0.0;
+    if (!backend || !backend->potential_energy(*this, *effect, particles.x, e))
+      e = effect->potential_energy(particles, particles.x);
+    energy += e;
+    if (each) each->push_back(e);
+  }
   return energy;
 }
 

@@ -91,11 +91,10 @@ class World {
   void for_items(Index n, const std::function<void(Index begin, Index end)>& range) const;
 
   // Diagnostics of the current state.
-  double kinetic_energy() const;    // sum of 1/2 m |v|^2 [J] (pinned particles do not move)
-  double potential_energy() const;  // sum over force effects [J]
-  // One force effect's potential energy at the current state [J]: the backend's when it
-  // computes it (the same bits), else the effect's own. potential_energy() adds these up.
-  double potential_energy_of(const ForceEffect& effect) const;
+  double kinetic_energy() const;  // sum of 1/2 m |v|^2 [J] (pinned particles do not move)
+  // Sum over force effects [J], each effect's term the backend's when it computes it (the same
+  // bits), else the effect's own; with `each`, effect e's term also in (*each)[e].
+  double potential_energy(std::vector<double>* each = nullptr) const;
   Vec3 momentum() const;  // sum of m v [kg m/s]
 
   // "gravity, gravitation; symplectic-euler": what a report or an error names as in play.
