@@ -67,6 +67,22 @@ duration = 1.0
 )" + extra;
 }
 
+// Buoyancy taken out of cloth()'s scene: every effect left has a fast form, and an Euler step
+// is one pass of the threads.
+void no_buoyancy(clothlab::World& w) {
+  std::erase_if(w.force_effects, [](const auto& e) { return e->name() == "buoyancy"; });
+}
+
+// A run of cloth()'s scene without buoyancy, every force summed by the fast engine, gives the
+// state `expected` has, bit for bit.
+void check_fast_state(const clothlab::World& fast, const clothlab::World& expected) {
+  REQUIRE(engine_of(fast).plan().ends_with("drag+"));
+  CHECK(fast.backend_evaluations == fast.force_evaluations);
+  CHECK(identical(fast.particles.x, expected.particles.x));
+  CHECK(identical(fast.particles.v, expected.particles.v));
+  CHECK(identical(fast.particles.f, expected.particles.f));
+}
+
 clothlab::SpringDampers* spring_effect(clothlab::World& world, const char* name) {
   return clothlab::find_spring_effect(world, name);
 }
@@ -364,9 +380,6 @@ TEST_CASE("fast path: the Euler methods move particles in the pass that sums the
     for (int threads : {1, 2, 3}) {
       CAPTURE(method);
       CAPTURE(threads);
-      const auto no_buoyancy = [](clothlab::World& w) {
-        std::erase_if(w.force_effects, [](const auto& e) { return e->name() == "buoyancy"; });
-      };
       const clothlab::Scene readable_scene =
           run(cloth("", method), false, threads, 30, no_buoyancy);
       const clothlab::Scene fast_scene = run(cloth("", method), true, threads, 30, no_buoyancy);
@@ -389,9 +402,6 @@ TEST_CASE("fast path: blocks of any size give the readable state bit for bit") {
   // sides. Blocks of one particle, shorter than a row, ending mid-row and mid-chunk, and larger
   // than the cloth; with a ground and a sphere riding along (the cloth starts through both).
   const std::string text = cloth("[sphere]\ncentre = [0.4, -0.45, 0.0]\nradius = 0.08\n");
-  const auto no_buoyancy = [](clothlab::World& w) {
-    std::erase_if(w.force_effects, [](const auto& e) { return e->name() == "buoyancy"; });
-  };
   const clothlab::Scene readable = run(text, false, 1, 40, no_buoyancy);
   CHECK(readable.world.particles.x.row(1).minCoeff() == -0.6);  // particles lie on the ground
   for (const Index block : {Index{1}, Index{29}, Index{600}, Index{1000}, Index{100000}}) {
@@ -402,11 +412,7 @@ TEST_CASE("fast path: blocks of any size give the readable state bit for bit") {
         no_buoyancy(w);
         engine_of(w).pass_block = block;
       });
-      REQUIRE(engine_of(fast.world).plan().ends_with("drag+"));
-      CHECK(fast.world.backend_evaluations == fast.world.force_evaluations);
-      CHECK(identical(fast.world.particles.x, readable.world.particles.x));
-      CHECK(identical(fast.world.particles.v, readable.world.particles.v));
-      CHECK(identical(fast.world.particles.f, readable.world.particles.f));
+      check_fast_state(fast.world, readable.world);
     }
   }
 }
@@ -466,6 +472,121 @@ TEST_CASE("fast path: 2, 3 and 4 threads give the 1-thread state bit for bit") {
   const std::string small = cloth("", "symplectic-euler", 9, 7);
   CHECK(identical(run(small, true, 4, 50).world.particles.x,
                   run(small, false, 1, 50).world.particles.x));
+}
+
+TEST_CASE("fast path: any split of the particles between threads gives the 1-thread state") {
+  // The fast engine's passes move the split of the particles between the threads toward the
+  // busier thread's side (World::for_particles_with_barrier), so a step may take any split.
+  // Here a new one before every step, drawn at random: pieces empty, of one particle, and
+  // bounds off any multiple of 16; on a cloth through a ground and a sphere, which ride along.
+  const std::string text = cloth("[sphere]\ncentre = [0.4, -0.45, 0.0]\nradius = 0.08\n");
+  const clothlab::Scene one = run(text, true, 1, 60, no_buoyancy);
+  for (int threads : {2, 3}) {
+    CAPTURE(threads);
+    clothlab::Scene scene = clothlab::parse_scene(text, "fast-path.toml");
+    no_buoyancy(scene.world);
+    scene.world.threads = threads;
+    const Index n = scene.world.particles.size();
+    std::mt19937 random(7);
+    std::uniform_int_distribution<Index> anywhere(0, n);
+    for (int s = 0; s < 60; ++s) {
+      std::vector<Index> bounds{0, n};
+      for (int t = 1; t < threads; ++t)
+        bounds.insert(bounds.end() - 1,
+                      s % 10 == 0 ? Index{s % 20 == 0 ? 0 : 1} : anywhere(random));
+      std::sort(bounds.begin(), bounds.end());
+      scene.world.set_particle_bounds(bounds);
+      scene.world.step(scene.dt);
+    }
+    check_fast_state(scene.world, one.world);
+  }
+}
+
+TEST_CASE("fast path: the world's passes take the split it keeps, and it stays a split") {
+  clothlab::Scene scene = clothlab::parse_scene(cloth(""), "fast-path.toml");
+  clothlab::World& world = scene.world;
+  const Index n = world.particles.size();
+  world.threads = 3;
+  CHECK(world.particle_bounds() == clothlab::even_bounds(n, 3));
+  world.set_particle_bounds({0, 5, 37, n});
+  std::vector<std::pair<Index, Index>> pieces(3), with_barrier(3);
+  std::vector<std::atomic<int>> calls(3);
+  world.for_particles([&](Index begin, Index end) {
+    const size_t t = begin == 0 ? 0 : begin == 5 ? 1 : 2;
+    pieces[t] = {begin, end};
+    ++calls[t];
+  });
+  CHECK(pieces == std::vector<std::pair<Index, Index>>{{0, 5}, {5, 37}, {37, n}});
+  // Not a split of the particles: refused, and the one kept stays.
+  for (const std::vector<Index>& bad : std::vector<std::vector<Index>>{
+           {0, 5, n}, {1, 5, 37, n}, {0, 37, 5, n}, {0, 5, 37, n + 1}, {0, 5, 37, n - 1}}) {
+    CHECK_THROWS_AS(world.set_particle_bounds(bad), std::invalid_argument);
+  }
+  CHECK(world.particle_bounds()[1] == 5);
+  world.for_particles_with_barrier([&](Index begin, Index end, const clothlab::Barrier& barrier) {
+    barrier.wait();
+    const size_t t = begin == 0 ? 0 : begin == 5 ? 1 : 2;
+    with_barrier[t] = {begin, end};
+    ++calls[t];
+  });
+  CHECK(with_barrier == pieces);  // (its pass may have moved the split since, for the next)
+  for (const auto& count : calls)
+    CHECK(count == 2);
+  // After steps whose passes may have moved it, still a split; another count of threads starts
+  // from the even one.
+  for (int s = 0; s < 30; ++s)
+    world.step(scene.dt);
+  const std::vector<Index>& after = world.particle_bounds();
+  REQUIRE(after.size() == 4);
+  CHECK(after.front() == 0);
+  CHECK(after.back() == n);
+  CHECK(std::is_sorted(after.begin(), after.end()));
+  world.threads = 2;
+  CHECK(world.particle_bounds() == clothlab::even_bounds(n, 2));
+}
+
+TEST_CASE("fast path: balance_bounds gives the costlier piece fewer items, a step at a time") {
+  using clothlab::balance_bounds;
+  using Bounds = std::vector<Index>;
+  // Within the tolerance, or with no time measured, nothing moves.
+  Bounds b{0, 1000, 2000};
+  CHECK_FALSE(balance_bounds(b, {1.0, 1.02}, 16, 1000, 0.03));
+  CHECK_FALSE(balance_bounds(b, {0.0, 0.0}, 16, 1000, 0.03));
+  CHECK_FALSE(balance_bounds(b, {std::nan(""), 1.0}, 16, 1000, 0.03));
+  CHECK_FALSE(balance_bounds(b, {-1.0, 1.0}, 16, 1000, 0.03));
+  CHECK(b == Bounds{0, 1000, 2000});
+  // Piece 0's items cost 3 times piece 1's: the costs even out at 1000 x 2 / 3 = 666.7; the bound
+  // goes half way there, 833.3, onto a multiple of 16.
+  CHECK(balance_bounds(b, {3.0, 1.0}, 16, 1000, 0.03));
+  CHECK(b == Bounds{0, 832, 2000});
+  // At most max_shift a call (then onto the nearest multiple of 16).
+  b = {0, 1000, 2000};
+  CHECK(balance_bounds(b, {3.0, 1.0}, 16, 64, 0.03));
+  CHECK(b == Bounds{0, 944, 2000});
+  // An empty piece gets items back.
+  b = {0, 0, 100};
+  CHECK(balance_bounds(b, {0.0, 1.0}, 16, 1000, 0.03));
+  CHECK(b == Bounds{0, 32, 100});
+  // Repeated, as passes do, on items whose cost does not change: three pieces, the last third of
+  // the items 4 times as costly. The pieces' work ends within the tolerance of the mean.
+  const auto cost = [](Index i) { return i < 600 ? 1.0 : 4.0; };
+  const auto work_of = [&](const Bounds& bounds) {
+    std::vector<double> work(bounds.size() - 1, 0.0);
+    for (size_t t = 0; t + 1 < bounds.size(); ++t)
+      for (Index i = bounds[t]; i < bounds[t + 1]; ++i)
+        work[t] += cost(i);
+    return work;
+  };
+  b = clothlab::even_bounds(900, 3);
+  int moves = 0;
+  while (balance_bounds(b, work_of(b), 1, 20, 0.03))
+    REQUIRE(++moves < 100);
+  CHECK(moves > 5);
+  const std::vector<double> work = work_of(b);
+  CHECK(*std::max_element(work.begin(), work.end()) <= 1.03 * 1800.0 / 3.0);
+  CHECK(b.front() == 0);
+  CHECK(b.back() == 900);
+  CHECK(std::is_sorted(b.begin(), b.end()));
 }
 
 TEST_CASE("fast path: runs just below, at and above the gap where forces skip the buffer") {
@@ -729,9 +850,6 @@ TEST_CASE(
   // The cloth hangs from y = 0 to y = -0.88: its lower rows start below the ground (y = -0.6)
   // and some particles inside the sphere, so both push particles out from the first step.
   const std::string sphere = "[sphere]\ncentre = [0.4, -0.45, 0.0]\nradius = 0.08\n";
-  const auto no_buoyancy = [](clothlab::World& w) {
-    std::erase_if(w.force_effects, [](const auto& e) { return e->name() == "buoyancy"; });
-  };
   // With buoyancy last (no fast path) the particles move after the forces' pass, without it in
   // that pass; the Euler methods move in one pass either way, RK4 does not.
   for (const char* method : {"symplectic-euler", "explicit-euler", "rk4"}) {
@@ -875,9 +993,6 @@ TEST_CASE("fast path: an Euler step wakes the threads once, and so does a force 
   // with a barrier inside it (FastEngine::pass): each step wakes them once, and the guard's
   // energy check (every 32 steps) once more, for the springs' energies. Buoyancy (no fast
   // form) is taken out, so that every effect has one; the ground rides along in the pass.
-  const auto no_buoyancy = [](clothlab::World& w) {
-    std::erase_if(w.force_effects, [](const auto& e) { return e->name() == "buoyancy"; });
-  };
   for (const char* method : {"symplectic-euler", "explicit-euler"}) {
     for (int threads : {2, 3}) {
       CAPTURE(method);
@@ -909,9 +1024,6 @@ TEST_CASE("fast path: a state spoiled between steps stops the one-job pass befor
   // there if any found a bad value: the guard then names the step about to be taken and the
   // particle, and no particle has moved. The spoiled particle in the first range, the last, and
   // (on 3 threads) the middle one.
-  const auto no_buoyancy = [](clothlab::World& w) {
-    std::erase_if(w.force_effects, [](const auto& e) { return e->name() == "buoyancy"; });
-  };
   for (int threads : {1, 2, 3}) {
     for (const Index bad : {Index{5}, Index{900}, Index{1840}}) {
       CAPTURE(threads);

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <stdexcept>
 #include <system_error>
 
@@ -152,15 +153,69 @@ void Barrier::wait() const {
   *waited_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
 
+std::vector<Index> even_bounds(Index n, int parts) {
+  std::vector<Index> bounds(static_cast<size_t>(parts) + 1);
+  for (int t = 0; t <= parts; ++t)
+    bounds[static_cast<size_t>(t)] = n * t / parts;
+  return bounds;
+}
+
+bool balance_bounds(std::vector<Index>& bounds, const std::vector<double>& work, Index align,
+                    Index max_shift, double tolerance) {
+  const size_t parts = work.size();
+  if (parts < 2 || bounds.size() != parts + 1) return false;
+  double total = 0.0, busiest = 0.0;
+  for (const double w : work) {
+    if (!(w >= 0.0) || !std::isfinite(w)) return false;  // a clock that went wrong: no guess
+    total += w;
+    busiest = std::max(busiest, w);
+  }
+  if (!(total > 0.0) || busiest <= (1.0 + tolerance) * total / static_cast<double>(parts))
+    return false;
+  // The measured cost as a function of the item: piece t's work spread evenly over its items.
+  // Bound k should sit where that cost reaches k / parts of the total.
+  const auto where = [&](double cost) {
+    double before = 0.0;
+    for (size_t t = 0; t < parts; ++t) {
+      const Index length = bounds[t + 1] - bounds[t];
+      if (cost <= before + work[t] && work[t] > 0.0)
+        return static_cast<double>(bounds[t]) +
+               (cost - before) / work[t] * static_cast<double>(length);
+      before += work[t];
+    }
+    return static_cast<double>(bounds.back());
+  };
+  const Index n = bounds.back();
+  bool moved = false;
+  for (size_t k = 1; k < parts; ++k) {
+    const double goal = where(total * static_cast<double>(k) / static_cast<double>(parts));
+    const double half = std::clamp(0.5 * (goal - static_cast<double>(bounds[k])),
+                                   -static_cast<double>(max_shift), static_cast<double>(max_shift));
+    Index next = static_cast<Index>(std::llround((static_cast<double>(bounds[k]) + half) /
+                                                 static_cast<double>(align))) *
+                 align;
+    next = std::clamp(next, bounds[k - 1], n);
+    if (next == bounds[k]) continue;
+    bounds[k] = next;
+    moved = true;
+  }
+  return moved;
+}
+
 void for_ranges_with_barrier(
-    ThreadTeam* team, Index n,
+    ThreadTeam* team, const std::vector<Index>& bounds,
     const std::function<void(Index begin, Index end, const Barrier& barrier)>& range,
-    ThreadProfile* profile) {
+    ThreadProfile* profile, std::vector<double>* work) {
   const int parts = team ? team->size() : 1;
   const auto piece = [&](int t, ThreadTeam* meet, double* waited) {
-    range(n * t / parts, n * (t + 1) / parts, Barrier(meet, waited));
+    if (parts == 1) {
+      range(bounds.front(), bounds.back(), Barrier(nullptr, waited));
+    } else {
+      range(bounds[static_cast<size_t>(t)], bounds[static_cast<size_t>(t) + 1],
+            Barrier(meet, waited));
+    }
   };
-  if (!profile) {
+  if (!profile && !work) {
     if (parts == 1) {
       piece(0, nullptr, nullptr);
     } else {
@@ -172,11 +227,13 @@ void for_ranges_with_barrier(
   const auto since = [](Clock::time_point start) {
     return std::chrono::duration<double>(Clock::now() - start).count();
   };
-  std::vector<double> work(static_cast<size_t>(parts), 0.0);  // waits first, then the work
+  std::vector<double> own;
+  std::vector<double>& times = work ? *work : own;  // waits first, then the work
+  times.assign(static_cast<size_t>(parts), 0.0);
   const Clock::time_point start = Clock::now();
   const auto timed_piece = [&](int t) {
     const Clock::time_point begun = Clock::now();
-    double& waited = work[static_cast<size_t>(t)];
+    double& waited = times[static_cast<size_t>(t)];
     piece(t, parts == 1 ? nullptr : team, &waited);
     waited = since(begun) - waited;
   };
@@ -185,10 +242,11 @@ void for_ranges_with_barrier(
   } else {
     team->run(timed_piece);
   }
+  if (!profile) return;
   profile->wall += since(start);
   ++profile->jobs;
   double busiest = 0.0, sum = 0.0;
-  for (const double w : work) {
+  for (const double w : times) {
     busiest = std::max(busiest, w);
     sum += w;
   }

@@ -82,6 +82,35 @@ void for_ranges(ThreadTeam* team, Index n, const Range& range) {
   team->run([&](int t) { range(n * t / parts, n * (t + 1) / parts); });
 }
 
+// The even split of [0, n) into `parts` pieces: bounds[t] = n t / parts for t = 0 .. parts, so
+// piece t is [bounds[t], bounds[t + 1]).
+std::vector<Index> even_bounds(Index n, int parts);
+
+// for_ranges on pieces given by their bounds (team->size() + 1 of them, as even_bounds makes):
+// range(bounds[t], bounds[t + 1]) on thread t, or the whole of [bounds.front(), bounds.back())
+// on this thread when team is null.
+template <class Range>
+void for_bounds(ThreadTeam* team, const std::vector<Index>& bounds, const Range& range) {
+  if (!team || team->size() == 1) {
+    range(bounds.front(), bounds.back());
+    return;
+  }
+  team->run(
+      [&](int t) { range(bounds[static_cast<size_t>(t)], bounds[static_cast<size_t>(t) + 1]); });
+}
+
+// Moves the inner bounds of the pieces toward the split in which every piece would take the same
+// time, were the work measured on each (work[t] for piece t, in any unit) spread evenly over its
+// items: the pieces of a pass whose items cost unequal amounts (a cloth whose contacts lie in
+// one thread's particles) even out over the passes that follow. Nothing moves while the busiest
+// piece is within `tolerance` of the mean (0.03: three percent), so that a balanced pass's
+// timing noise does not shift it back and forth; each bound moves half way to where it should
+// be, by at most max_shift items, so that one piece slowed once by something else (another
+// program on its core) moves the split little; a bound it moves lands on a multiple of `align`
+// (pieces that share no cache line), and pieces keep their order. Returns whether a bound moved.
+bool balance_bounds(std::vector<Index>& bounds, const std::vector<double>& work, Index align,
+                    Index max_shift, double tolerance);
+
 // What a range of for_ranges_with_barrier may wait at: wait() returns once every thread of the
 // job has reached it (ThreadTeam::sync); on one thread it returns at once.
 class Barrier {
@@ -109,9 +138,11 @@ struct ThreadProfile {
 // work that must not overlap across threads: all of it one job, one wake of the threads. Every
 // range must call it the same number of times, an empty range too. With a profile, each job
 // adds its times there (two clock reads a thread and a wait more).
+// The pieces are given by their bounds (for_bounds). With `work`, each thread's work in the job
+// (its time less its waits at the barrier, in seconds) is left in (*work)[t].
 void for_ranges_with_barrier(
-    ThreadTeam* team, Index n,
+    ThreadTeam* team, const std::vector<Index>& bounds,
     const std::function<void(Index begin, Index end, const Barrier& barrier)>& range,
-    ThreadProfile* profile = nullptr);
+    ThreadProfile* profile = nullptr, std::vector<double>* work = nullptr);
 
 }  // namespace clothlab

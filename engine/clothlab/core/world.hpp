@@ -84,8 +84,19 @@ class World {
   void for_particles(const std::function<void(Index begin, Index end)>& range) const;
   // The same, where range may wait at barrier.wait() until every thread has done the part of its
   // work before it (for_ranges_with_barrier): a pass in two parts for one wake of the threads.
+  // Its passes are the fast engine's (a step's, a force sum's): the time each thread worked in one
+  // moves the split of the particles for the passes after it (balance_bounds), so that a thread
+  // whose particles cost more (the part of a cloth that lies on the ground) gets fewer of them.
   void for_particles_with_barrier(
       const std::function<void(Index begin, Index end, const Barrier& barrier)>& range) const;
+  // Where each thread's particles begin, threads + 1 bounds, the last the number of particles:
+  // for_particles and for_particles_with_barrier give thread t [bounds[t], bounds[t + 1]). The
+  // even split until a pass of for_particles_with_barrier moves it, and again when the number of
+  // threads or of particles changes. Any split gives the same bits.
+  const std::vector<Index>& particle_bounds() const;
+  // Sets that split (a test's, or a benchmark's): threads + 1 bounds, from 0 up to the number of
+  // particles, none smaller than the one before; std::invalid_argument otherwise.
+  void set_particle_bounds(std::vector<Index> bounds) const;
   // The same for any n items (a backend's loop over independent constraints): contiguous
   // ranges that cover [0, n) once each, one a thread.
   void for_items(Index n, const std::function<void(Index begin, Index end)>& range) const;
@@ -107,6 +118,8 @@ class World {
   ThreadTeam* team() const;  // the threads of a step, or null for one thread
 
   mutable std::unique_ptr<ThreadTeam> team_;
+  mutable std::vector<Index> particle_bounds_;  // particle_bounds()
+  mutable std::vector<double> pass_work_;       // each thread's work in the last pass [s]
 };
 
 }  // namespace clothlab
