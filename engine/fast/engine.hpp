@@ -11,7 +11,9 @@
 //      a run of springs (springs.hpp), reads each component in memory order, so the compiler
 //      computes four springs at once with vector instructions, through the same exercise
 //      kernels. With threads, each takes a contiguous range of particles and every effect adds
-//      the forces on that range only: no two threads write the same force;
+//      the forces on that range only: no two threads write the same force. The ranges follow
+//      the threads' work (World::particle_bounds: a pass that one thread took longer over
+//      gives it fewer particles in the next);
 //   3. copy f back.
 //
 // With threads, the copy and the sums are one job of the team: each thread copies its own
