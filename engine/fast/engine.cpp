@@ -154,16 +154,27 @@ BackendStep FastEngine::step(World& world, double dt) {
   // world's list ride along: each range meets them right after it moves, in the list's order,
   // as it would in passes of their own. The others follow the step (World::step).
   contacts_.clear();
+  starts_.clear();
   for (const auto& effect : world.post_step_effects) {
-    if (const auto* ground = dynamic_cast<const Ground*>(effect.get())) {
+    if (auto* ground = dynamic_cast<Ground*>(effect.get())) {
       contacts_.push_back({ground, nullptr});
-    } else if (const auto* sphere = dynamic_cast<const Sphere*>(effect.get())) {
+      starts_.push_back(&ground->step_start());
+    } else if (auto* sphere = dynamic_cast<Sphere*>(effect.get())) {
       contacts_.push_back({nullptr, sphere});
+      starts_.push_back(&sphere->step_start());
     } else {
       break;
     }
   }
   Particles& p = world.particles;
+  // What the post-step effects record of the state the step starts from (World::record_step_start,
+  // which World::step leaves to a backend that takes the step): the contacts that ride along
+  // have each thread record its own particles in the pass, before anything moves, where a copy
+  // of the whole state on this thread would come first; the effects after them record here.
+  for (StepStart* start : starts_)
+    start->resize(p.size());
+  for (size_t k = contacts_.size(); k < world.post_step_effects.size(); ++k)
+    world.post_step_effects[k]->before_step(world);
   const MoveRange move =
       explicit_euler
           ? euler_move(p, dt,
@@ -189,6 +200,7 @@ BackendStep FastEngine::step(World& world, double dt) {
     moves = &move_then_contacts;
   }
   PassChecks checks;
+  checks.starts = &starts_;
   checks.end = contacts_.size() == world.post_step_effects.size();
   pass(world, p.x, p.v, p.f, moves, &checks);
   ++world.force_evaluations;
@@ -242,6 +254,10 @@ void FastEngine::pass(const World& world, const Matrix3X& x, const Matrix3X& v, 
       const bool v_within =
           to_soa_within(begin, end, v.data(), c.v.data(), c.v.cols(), world.guard.max_speed);
       if (!x_within || !v_within) start_within = false;
+      if (checks->starts) {
+        for (StepStart* start : *checks->starts)
+          start->record(x, v, begin, end);
+      }
     }
     c.f.middleCols(begin, end - begin).setZero();
     if (lead == 0) return;

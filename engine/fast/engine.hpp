@@ -65,6 +65,7 @@
 namespace clothlab {
 class Ground;
 class Sphere;
+class StepStart;
 struct Guard;
 }  // namespace clothlab
 
@@ -158,6 +159,9 @@ class FastEngine final : public Backend {
  private:
   // The guard's checks a step's one pass takes on (step).
   struct PassChecks {
+    // The contacts' records of the step's start (StepStart), sized for the particles: each
+    // thread records its own particles' x and v into them as it copies them, before the barrier.
+    const std::vector<StepStart*>* starts = nullptr;
     bool end = false;          // check the state after the move too
     bool end_checked = false;  // the pass checked every particle after moving it,
     bool end_within = false;   // and found them all within the guard's bounds
@@ -185,6 +189,7 @@ class FastEngine final : public Backend {
     const Sphere* sphere = nullptr;
   };
   std::vector<Contact> contacts_;
+  std::vector<StepStart*> starts_;  // theirs (PassChecks::starts)
   Copies copies_;
   SoA3 xpbd_x_, xpbd_old_;  // x and x_old in the fast layout, for XPBD's projections
   // VBD: the constants of every spring at every vertex, in the sweep's order (vbd.cpp).

@@ -162,6 +162,7 @@ BackendStep FloatRoom::step(World& world, double dt) {
                            "; this world has " + float_room_declines(world));
   }
   Particles& p = world.particles;
+  world.record_step_start();  // the step is taken: the post-step effects' record (backend.hpp)
   for (const FastForceSlot<float>& force : forces_)
     force.fast->prepare(p);  // float spring forms take every set (springs.cpp)
   const bool symplectic = dynamic_cast<const SymplecticEuler*>(world.integrator.get()) != nullptr;

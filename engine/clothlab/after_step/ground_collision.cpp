@@ -53,6 +53,16 @@ void StepStart::record(const World& world) {
   v_ = world.particles.v;
 }
 
+void StepStart::resize(Index n) {
+  x_.resize(3, n);
+  v_.resize(3, n);
+}
+
+void StepStart::record(const Matrix3X& x, const Matrix3X& v, Index begin, Index end) {
+  x_.middleCols(begin, end - begin) = x.middleCols(begin, end - begin);
+  v_.middleCols(begin, end - begin) = v.middleCols(begin, end - begin);
+}
+
 void Ground::apply(World& world, const StepTime& /*time*/) {
   collide(world.particles, 0, world.particles.size());
 }

@@ -50,6 +50,11 @@ struct ContactMaterial {
 class StepStart {
  public:
   void record(const World& world);
+  // The same in parts, for a backend whose threads each record their own particles (the fast
+  // engine's pass, before anything moves): resize for n particles, then record particles
+  // [begin, end) of x and v.
+  void resize(Index n);
+  void record(const Matrix3X& x, const Matrix3X& v, Index begin, Index end);
   // Where particle i was when the step began; false when it is not known (the effect was applied
   // outside World::step, or the particles changed in number since).
   bool known(const Particles& p) const { return x_.cols() == p.size(); }
@@ -73,6 +78,8 @@ class Ground final : public PostStepEffect {
   // apply's loop on particles [begin, end) only: each particle is pushed out from its own state
   // alone, so ranges may be taken apart (and by different threads at once).
   void collide(Particles& p, Index begin, Index end) const;
+  // What before_step records, for a backend that records it itself (World::record_step_start).
+  StepStart& step_start() { return start_; }
   double y0() const { return y0_; }
 
  private:
@@ -116,6 +123,8 @@ class Sphere final : public PostStepEffect {
   void apply(World& world, const StepTime& time) override;
   // apply's loop on particles [begin, end) only (as Ground::collide).
   void collide(Particles& p, Index begin, Index end) const;
+  // What before_step records, for a backend that records it itself (World::record_step_start).
+  StepStart& step_start() { return start_; }
   const Vec3& centre() const { return centre_; }
   double radius() const { return radius_; }
 

@@ -28,7 +28,9 @@ struct VbdGraph;
 struct BackendStep {
   // Steps 1-3 are done: the forces summed and every particle moved. The backend checked the
   // state the step started from as it read it, and threw the guard's error before moving
-  // anything if that state was bad (Guard::check with before_step).
+  // anything if that state was bad (Guard::check with before_step). Before moving anything it
+  // also had the post-step effects record the state the step started from, as
+  // World::record_step_start does (which World::step calls only when the step is declined).
   bool taken = false;
   // The first this many post-step effects of the world's list are applied as well.
   size_t post_step_done = 0;

@@ -25,12 +25,11 @@ void World::step(double dt) {
   if (steps == 0) guard.start(*this);
   for (const auto& effect : force_effects)
     effect->set_time(t);  // what changes in time takes its value at the step's start
-  for (const auto& effect : post_step_effects)
-    effect->before_step(*this);  // what needs the state the step starts from records it
   // The backend may take the step, or part of it, its own way with the same bits (backend.hpp),
   // checking the state as it goes; it says what it took, and the world does the rest.
   const BackendStep taken = backend ? backend->step(*this, dt) : BackendStep{};
   if (!taken.taken) {
+    record_step_start();  // what needs the state the step starts from records it
     {
       const auto timed = lap(timer, &StepTimes::guard);
       guard.check(*this, /*before_step=*/true);  // the guard: the state the step starts from
@@ -56,6 +55,11 @@ void World::step(double dt) {
     guard.check(*this, /*before_step=*/false);  // 5: the guard: the state the step ends with
   }
   if (steps % guard.energy_check_every == 0) guard.check_energy(*this);
+}
+
+void World::record_step_start() {
+  for (const auto& effect : post_step_effects)
+    effect->before_step(*this);
 }
 
 ThreadTeam* World::team() const {

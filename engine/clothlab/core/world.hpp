@@ -71,6 +71,11 @@ class World {
   // Takes one step of dt [s] (steps 1-5 and the substep contract above).
   void step(double dt);
 
+  // Every post-step effect records what it needs of the state the step starts from
+  // (PostStepEffect::before_step). step() calls it when no backend takes the step; a backend
+  // that takes it records the same before anything moves (backend.hpp).
+  void record_step_start();
+
   // Steps 1-2 at an arbitrary state: f = sum of every force effect at (x, v) [N]. The backend
   // sums them when it can; else the lecture's loop below does. Both give the same f, bit for bit.
   void compute_forces(const Matrix3X& x, const Matrix3X& v, Matrix3X& f) const;
