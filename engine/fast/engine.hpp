@@ -27,7 +27,8 @@
 // (pass_block): every effect adds its forces on the block, then the block moves. The pass also
 // checks each particle for the guard as it copies it and after it moves, and the ground and the
 // sphere, when they lead the world's post-step effects, push each particle out right after it
-// moves: the same checks and the same contacts, without passes of their own over the whole state.
+// moves (each thread records its particles' start for them as it copies them): the same checks
+// and the same contacts, without passes of their own over the whole state.
 //
 // Each particle receives the same floating-point operations in the same order as on the
 // lecture's path, so the two agree bit for bit, with any number of threads and any block size
