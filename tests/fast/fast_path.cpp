@@ -563,6 +563,11 @@ TEST_CASE("fast path: balance_bounds gives the costlier piece fewer items, a ste
   b = {0, 1000, 2000};
   CHECK(balance_bounds(b, {3.0, 1.0}, 16, 64, 0.03));
   CHECK(b == Bounds{0, 944, 2000});
+  // Three pieces, the first's items 4 times as costly: the costs even out at 300 x 1 / 2 = 150
+  // and at 300 (the first piece's end, as measured); each bound goes half way from where it was.
+  b = {0, 300, 600, 900};
+  CHECK(balance_bounds(b, {1200.0, 300.0, 300.0}, 1, 1000, 0.03));
+  CHECK(b == Bounds{0, 225, 450, 900});
   // An empty piece gets items back.
   b = {0, 0, 100};
   CHECK(balance_bounds(b, {0.0, 1.0}, 16, 1000, 0.03));

@@ -172,18 +172,20 @@ bool balance_bounds(std::vector<Index>& bounds, const std::vector<double>& work,
   }
   if (!(total > 0.0) || busiest <= (1.0 + tolerance) * total / static_cast<double>(parts))
     return false;
-  // The measured cost as a function of the item: piece t's work spread evenly over its items.
-  // Bound k should sit where that cost reaches k / parts of the total.
+  // The measured cost as a function of the item: piece t's work spread evenly over its items
+  // (the pieces as they were measured). Bound k should sit where that cost reaches k / parts of
+  // the total.
+  const std::vector<Index> measured = bounds;
   const auto where = [&](double cost) {
     double before = 0.0;
     for (size_t t = 0; t < parts; ++t) {
-      const Index length = bounds[t + 1] - bounds[t];
+      const Index length = measured[t + 1] - measured[t];
       if (cost <= before + work[t] && work[t] > 0.0)
-        return static_cast<double>(bounds[t]) +
+        return static_cast<double>(measured[t]) +
                (cost - before) / work[t] * static_cast<double>(length);
       before += work[t];
     }
-    return static_cast<double>(bounds.back());
+    return static_cast<double>(measured.back());
   };
   const Index n = bounds.back();
   bool moved = false;

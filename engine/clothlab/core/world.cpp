@@ -86,7 +86,7 @@ const std::vector<Index>& World::particle_bounds() const {
   return particle_bounds_;
 }
 
-void World::set_particle_bounds(std::vector<Index> bounds) const {
+void World::set_particle_bounds(std::vector<Index> bounds) {
   const auto parts = static_cast<size_t>(std::max(1, threads));
   bool ordered =
       bounds.size() == parts + 1 && bounds.front() == 0 && bounds.back() == particles.size();

@@ -101,7 +101,7 @@ class World {
   const std::vector<Index>& particle_bounds() const;
   // Sets that split (a test's, or a benchmark's): threads + 1 bounds, from 0 up to the number of
   // particles, none smaller than the one before; std::invalid_argument otherwise.
-  void set_particle_bounds(std::vector<Index> bounds) const;
+  void set_particle_bounds(std::vector<Index> bounds);
   // The same for any n items (a backend's loop over independent constraints): contiguous
   // ranges that cover [0, n) once each, one a thread.
   void for_items(Index n, const std::function<void(Index begin, Index end)>& range) const;
