@@ -107,11 +107,9 @@ void World::for_particles(const std::function<void(Index begin, Index end)>& ran
 void World::for_particles_with_barrier(
     const std::function<void(Index begin, Index end, const Barrier& barrier)>& range) const {
   ThreadTeam* const threads_of_step = team();
-  if (!threads_of_step) {
-    for_ranges_with_barrier(threads_of_step, particle_bounds(), range, thread_profile);
-    return;
-  }
-  for_ranges_with_barrier(threads_of_step, particle_bounds(), range, thread_profile, &pass_work_);
+  for_ranges_with_barrier(threads_of_step, particle_bounds(), range, thread_profile,
+                          threads_of_step ? &pass_work_ : nullptr);
+  if (!threads_of_step) return;
   // A bound moves at most a 128th of the cloth a pass: a 10 % shift takes some 25 passes, and a
   // pass that one thread lost to another program moves the split by under 1 %.
   const Index n = particles.size();
