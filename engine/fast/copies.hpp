@@ -49,6 +49,13 @@ struct CopiesOf {
 };
 using Copies = CopiesOf<double>;
 
+// The two copies of the state a run of steps takes turns with (resident.hpp): the one a step
+// reads, and the one its move writes.
+template <class Scalar>
+struct ResidentOf {
+  CopiesOf<Scalar> a, b;
+};
+
 // Particles [begin, end) of a (the engine's layout: x, y, z of particle i at a[3 i], a[3 i + 1],
 // a[3 i + 2]) into s (rows `stride` apart). One pass, particle by particle: each particle's
 // three components come from one cache line, where copying row by row would read a three times.

@@ -8,6 +8,7 @@
 #include "clothlab/core/world.hpp"
 #include "clothlab/integrators/euler.hpp"
 #include "fast/float_room.hpp"
+#include "fast/resident.hpp"
 
 namespace clothlab::fast {
 
@@ -54,6 +55,29 @@ template <bool Check, class Kernel>
       f_out[3 * i + c] = f[c * nf + i];
       if constexpr (Check)
         outside += !(std::abs(next.r[c]) <= max_position) + !(std::abs(next.v[c]) <= max_speed);
+    }
+  }
+  return outside == 0;
+}
+
+// The same moves into the other copy of the state, for a run of steps that keeps it in the
+// fast layout (resident.hpp): the new x and v to next's rows (x_out, v_out, strides nxo and nvo),
+// tested against the guard's bounds as above; the forces stay in the copies.
+template <class Kernel>
+[[gnu::noinline, gnu::flatten]] bool move_particles_resident(
+    Index begin, Index end, double dt, Kernel kernel, const double* __restrict x, Index nx,
+    const double* __restrict v, Index nv, const double* __restrict f, Index nf,
+    const double* __restrict inv_m, double* __restrict x_out, Index nxo, double* __restrict v_out,
+    Index nvo, double max_position, double max_speed) {
+  long outside = 0;
+  for (Index i = begin; i < end; ++i) {
+    PointState next =  // not const: see above
+        kernel(Vec3(x[i], x[nx + i], x[2 * nx + i]), Vec3(v[i], v[nv + i], v[2 * nv + i]),
+               Vec3(f[i], f[nf + i], f[2 * nf + i]), inv_m[i], dt);
+    for (int c = 0; c < 3; ++c) {
+      x_out[c * nxo + i] = next.r[c];
+      v_out[c * nvo + i] = next.v[c];
+      outside += !(std::abs(next.r[c]) <= max_position) + !(std::abs(next.v[c]) <= max_speed);
     }
   }
   return outside == 0;
@@ -206,6 +230,43 @@ BackendStep FastEngine::step(World& world, double dt) {
   ++world.force_evaluations;
   ++world.backend_evaluations;
   return {true, contacts_.size(), checks.end_checked && checks.end_within};
+}
+
+BackendSteps FastEngine::steps(World& world, double dt, long count) {
+  if (count <= 0 || !world.post_step_effects.empty()) return {};
+  if (precision == Precision::float32) {
+    if (!float_room_) float_room_ = std::make_shared<FloatRoom>();
+    return float_room_->steps(world, dt, count);
+  }
+  const Integrator* integrator = world.integrator.get();
+  const bool explicit_euler = dynamic_cast<const ExplicitEuler*>(integrator) != nullptr;
+  if (!explicit_euler && !dynamic_cast<const SymplecticEuler*>(integrator)) return {};
+  if (!prepare(world)) return {};
+  for (const Force& force : forces_) {
+    if (!force.on) return {};  // an effect without a fast form needs the world's layout
+  }
+  const Particles& p = world.particles;
+  const auto add = [&](Index b0, Index b1, const SoA3& x, const SoA3& v, SoA3& f) {
+    for (const Force& force : forces_)
+      force.fast->add(p, x, v, f, b0, b1);
+  };
+  const auto moves = [&](auto kernel) {
+    return [&, kernel](Index c0, Index c1, const Copies& now, Copies& next) {
+      return move_particles_resident(c0, c1, dt, kernel, now.x.data(), now.x.cols(), now.v.data(),
+                                     now.v.cols(), now.f.data(), now.f.cols(), p.inv_m.data(),
+                                     next.x.data(), next.x.cols(), next.v.data(), next.v.cols(),
+                                     world.guard.max_position, world.guard.max_speed);
+    };
+  };
+  const Index block = std::max<Index>(pass_block, 1);
+  if (explicit_euler) {
+    return resident_steps(world, dt, count, resident_, block, kPassChunk, add,
+                          moves([](const Vec3& r, const Vec3& v, const Vec3& f, double inv_m,
+                                   double h) { return explicit_euler_step(r, v, f, inv_m, h); }));
+  }
+  return resident_steps(world, dt, count, resident_, block, kPassChunk, add,
+                        moves([](const Vec3& r, const Vec3& v, const Vec3& f, double inv_m,
+                                 double h) { return symplectic_euler_step(r, v, f, inv_m, h); }));
 }
 
 void FastEngine::pass(const World& world, const Matrix3X& x, const Matrix3X& v, Matrix3X& f,

@@ -30,6 +30,13 @@
 // moves (each thread records its particles' start for them as it copies them): the same checks
 // and the same contacts, without passes of their own over the whole state.
 //
+// Several steps at once (World::advance, Backend::steps), in a world with no post-step effect
+// whose force effects all have a fast form, keep the state in the copies between them
+// (resident.hpp): two copies, the one a step reads and the one its move writes, in turn; x and v
+// are copied in before the first step and x, v and f written back after the last. All the steps
+// are one job of the threads, with barriers between them. `clothlab run` takes the steps between
+// two frames that way, and `clothlab bench speed` times the engine so.
+//
 // Each particle receives the same floating-point operations in the same order as on the
 // lecture's path, so the two agree bit for bit, with any number of threads and any block size
 // (tests/fast/). An effect the engine does not know (buoyancy, gravitation) adds its forces with
@@ -50,7 +57,8 @@
 // threads, with the bits of the integrator's own loop.
 //
 // With `[engine] precision = "float"` it hands each step to the float room (float_room.hpp): the
-// same pass in single precision, for the Euler methods and the effects listed there.
+// same pass in single precision, for the Euler methods and the effects listed there (and runs
+// of steps with the state kept in float between them).
 #pragma once
 
 #include <functional>
@@ -118,6 +126,10 @@ class FastEngine final : public Backend {
 
   bool sum_forces(const World& world, const Matrix3X& x, const Matrix3X& v, Matrix3X& f) override;
   BackendStep step(World& world, double dt) override;
+  // Steps of an Euler method whose force effects all have a fast form, in a world with no
+  // post-step effect, the state kept in the fast layout between them (resident.hpp); in float
+  // in the float room.
+  BackendSteps steps(World& world, double dt, long count) override;
   bool potential_energy(const World& world, const ForceEffect& effect, const Matrix3X& x,
                         double& energy) override;
   bool xpbd_project(World& world, const XpbdConstraints& constraints, const Matrix3X& x_old,
@@ -192,7 +204,8 @@ class FastEngine final : public Backend {
   std::vector<Contact> contacts_;
   std::vector<StepStart*> starts_;  // theirs (PassChecks::starts)
   Copies copies_;
-  SoA3 xpbd_x_, xpbd_old_;  // x and x_old in the fast layout, for XPBD's projections
+  ResidentOf<double> resident_;  // steps' two copies of the state
+  SoA3 xpbd_x_, xpbd_old_;       // x and x_old in the fast layout, for XPBD's projections
   // VBD: the constants of every spring at every vertex, in the sweep's order (vbd.cpp).
   struct VbdSpring {
     Index other;        // the spring's other end

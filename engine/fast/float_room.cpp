@@ -11,6 +11,7 @@
 #include "clothlab/core/world.hpp"
 #include "clothlab/integrators/euler.hpp"
 #include "fast/engine.hpp"
+#include "fast/resident.hpp"
 #include "fast/scalar_kernels.hpp"
 
 namespace clothlab::fast {
@@ -92,6 +93,33 @@ template <bool Symplectic>
   return outside == 0;
 }
 
+// The same move into the other copy of the state, for a run of steps that keeps it in float
+// (resident.hpp): the new x and v to next's rows (x_out, v_out, strides nxo and nvo), tested as
+// above; the forces stay in the copies.
+template <bool Symplectic>
+[[gnu::noinline]] bool move_in_float_resident(
+    Index begin, Index end, float dt, const float* __restrict x, Index nx,
+    const float* __restrict v, Index nv, const float* __restrict f, Index nf,
+    const double* __restrict inv_m, float* __restrict x_out, Index nxo, float* __restrict v_out,
+    Index nvo, double max_position, double max_speed) {
+  long outside = 0;
+  for (Index i = begin; i < end; ++i) {
+    const Vec3f fi(f[i], f[nf + i], f[2 * nf + i]);
+    const Vec3f xi(x[i], x[nx + i], x[2 * nx + i]);
+    const Vec3f vi(v[i], v[nv + i], v[2 * nv + i]);
+    const float inv_mi = static_cast<float>(inv_m[i]);
+    PointStateOf<float> next = Symplectic ? symplectic_euler(xi, vi, fi, inv_mi, dt)
+                                          : explicit_euler(xi, vi, fi, inv_mi, dt);
+    for (int c = 0; c < 3; ++c) {
+      x_out[c * nxo + i] = next.r[c];
+      v_out[c * nvo + i] = next.v[c];
+      const double r = next.r[c], u = next.v[c];
+      outside += !(std::abs(r) <= max_position) + !(std::abs(u) <= max_speed);
+    }
+  }
+  return outside == 0;
+}
+
 // The names of `effects` the float room does not cover, comma-separated, given what it covers.
 template <class Effects, class Covered>
 std::string uncovered(const Effects& effects, Covered covered) {
@@ -143,6 +171,34 @@ std::string use_float(World& world) {
     return "float covers " + std::string(kFloatCovers) + "; this scene has " + why;
   engine->precision = FastEngine::Precision::float32;
   return "";
+}
+
+BackendSteps FloatRoom::steps(World& world, double dt, long count) {
+  if (count <= 0 || !world.post_step_effects.empty()) return {};
+  const auto& effects = world.force_effects;
+  forces_.resize(effects.size());
+  for (size_t e = 0; e < effects.size(); ++e) {
+    forces_[e].match(*effects[e], fast_force_float);
+    if (!forces_[e].fast) return {};  // step() says what is not covered
+  }
+  const bool symplectic = dynamic_cast<const SymplecticEuler*>(world.integrator.get()) != nullptr;
+  if (!symplectic && !dynamic_cast<const ExplicitEuler*>(world.integrator.get())) return {};
+  const Particles& p = world.particles;
+  for (const FastForceSlot<float>& force : forces_)
+    force.fast->prepare(p);
+  const auto add = [&](Index b0, Index b1, const SoA3f& x, const SoA3f& v, SoA3f& f) {
+    for (const FastForceSlot<float>& force : forces_)
+      force.fast->add(p, x, v, f, b0, b1);
+  };
+  const float h = static_cast<float>(dt);
+  const auto move = symplectic ? move_in_float_resident<true> : move_in_float_resident<false>;
+  return resident_steps(world, dt, count, resident_, kPassBlock, kPassChunk, add,
+                        [&](Index c0, Index c1, const CopiesOf<float>& now, CopiesOf<float>& next) {
+                          return move(c0, c1, h, now.x.data(), now.x.cols(), now.v.data(),
+                                      now.v.cols(), now.f.data(), now.f.cols(), p.inv_m.data(),
+                                      next.x.data(), next.x.cols(), next.v.data(), next.v.cols(),
+                                      world.guard.max_position, world.guard.max_speed);
+                        });
 }
 
 BackendStep FloatRoom::step(World& world, double dt) {

@@ -59,10 +59,14 @@ class FloatRoom {
   // Throws std::logic_error when the world holds something it does not cover (the scene
   // reader refuses such a scene; a program that added an effect since gets the same words).
   BackendStep step(World& world, double dt);
+  // Steps in float with the state kept in float between them (resident.hpp), for a world with
+  // no post-step effect whose every force effect the float room covers; {} otherwise.
+  BackendSteps steps(World& world, double dt, long count);
 
  private:
   std::vector<FastForceSlot<float>> forces_;  // the world's force effects, in float
   CopiesOf<float> copies_;
+  ResidentOf<float> resident_;  // steps' two copies of the state
 };
 
 }  // namespace clothlab::fast

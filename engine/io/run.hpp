@@ -76,6 +76,10 @@ class RunStopped : public std::runtime_error {
 // (its end, the guard's SimulationError, RunStopped, an OutputError from a full disk), the files
 // hold whole frames and the viewer page shows them; the page is also rewritten during a long run
 // (every half minute or so), so that it is there after a crash.
+// The most steps a run takes at once (World::advance) between two frames, or two looks at the
+// stop signals: at most a few milliseconds of steps on the cloths the lessons run.
+inline constexpr long kRunStepsAtOnce = 32;
+
 RunReport run_scene(Scene& scene, const RunOutputs& outputs, const ProgressFn& progress = {});
 
 // The same with the usual outputs in `out_dir`.

@@ -16,6 +16,8 @@
 #include <string>
 #include <vector>
 
+#include <fmt/format.h>
+
 #include "clothlab/core/effect.hpp"
 #include "clothlab/core/guard.hpp"
 #include "clothlab/core/stop.hpp"
@@ -265,35 +267,48 @@ TEST_CASE("outputs: a second run clears the first run's frames and leaves the us
 
 TEST_CASE("outputs: a run stopped by a signal ends with a whole last frame and its page") {
   const fs::path dir = test::scratch_path("signal");
-  clothlab::Scene scene = clothlab::parse_scene(kCloth, "<cloth>");
-  // A TERM arrives after step 37, between frames (frames are every 10 steps).
-  const auto progress = [](long done, long) {
-    if (done == 37) std::raise(SIGTERM);
+  // Frames every 100 steps; the run takes its steps kRunStepsAtOnce at a time between frames
+  // (World::advance) and looks at the stop signals after each such run of steps.
+  std::string text = kCloth;
+  text.replace(text.find("fps = 100"), 9, "fps = 10");
+  clothlab::Scene scene = clothlab::parse_scene(text, "<cloth>");
+  // A TERM arrives with the first progress report at or after step 37: the run stops at the end
+  // of the steps it took at once, between frames.
+  constexpr long kAt = 37;
+  const long stop_step =
+      (kAt + clothlab::kRunStepsAtOnce - 1) / clothlab::kRunStepsAtOnce * clothlab::kRunStepsAtOnce;
+  REQUIRE(stop_step % 100 != 0);
+  bool raised = false;
+  const auto progress = [&raised](long done, long) {
+    if (done >= kAt && !raised) {
+      raised = true;
+      std::raise(SIGTERM);
+    }
   };
   long stopped_at = -1, frames = -1;
   try {
     clothlab::run_scene(scene, dir, progress);
   } catch (const clothlab::RunStopped& stop) {
     CHECK(stop.signal() == SIGTERM);
-    CHECK(std::string(stop.what()) == "stopped by SIGTERM after step 37");
+    CHECK(std::string(stop.what()) == "stopped by SIGTERM after step " + std::to_string(stop_step));
     stopped_at = stop.step();
     frames = stop.frames();
   }
-  CHECK(stopped_at == 37);
-  CHECK(frames == 5);  // steps 0, 10, 20, 30 and 37
-  CHECK(scene.world.t == doctest::Approx(0.037));
+  CHECK(stopped_at == stop_step);
+  CHECK(frames == 2);  // steps 0 and stop_step
+  CHECK(scene.world.t == doctest::Approx(0.001 * static_cast<double>(stop_step)));
 
   std::ifstream energy(dir / "energy.csv");
   std::vector<std::string> rows;
   for (std::string line; std::getline(energy, line);)
     rows.push_back(line);
-  REQUIRE(rows.size() == 6);
-  CHECK(rows.back().rfind("4,0.037", 0) == 0);
+  REQUIRE(rows.size() == 3);
+  CHECK(rows.back().rfind(fmt::format("1,{:g}", 0.001 * static_cast<double>(stop_step)), 0) == 0);
   const std::string positions = read_all(dir / "positions.csv");
   CHECK(positions.back() == '\n');
-  CHECK(std::count(positions.begin(), positions.end(), '\n') == 1 + 5 * 400);
+  CHECK(std::count(positions.begin(), positions.end(), '\n') == 1 + 2 * 400);
   const std::string page = read_all(dir / "view.html");
-  CHECK(page.find("\"times\":[0.0,0.01") != std::string::npos);
+  CHECK(page.find("\"times\":[0.0,0.0") != std::string::npos);
   // The handlers are gone with the run: the signal's usual meaning is back.
   CHECK(clothlab::StopSignals::received() == 0);
 }

@@ -38,6 +38,12 @@ struct BackendStep {
   bool checked_after = false;
 };
 
+// What a backend took of a run of steps (Backend::steps).
+struct BackendSteps {
+  long taken = 0;      // whole steps taken, each as World::step takes it; 0: declined
+  bool within = true;  // the state after the last of them is within the guard's bounds
+};
+
 class Backend {
  public:
   virtual ~Backend() = default;
@@ -49,6 +55,17 @@ class Backend {
 
   // Takes as much of one step of dt [s] as it can (see BackendStep); {} declines it all.
   virtual BackendStep step(World& world, double dt) = 0;
+  // Takes up to `count` steps of dt [s] one after the other, each as World::step would take it
+  // (the same bits): every force effect's set_time(world.t), the forces summed, every particle
+  // moved, the state checked, then world.t += dt and ++world.steps. Between two of them the state
+  // may stay in the backend's own layout; after the last, the world's particles hold it (x, v and
+  // f, as after World::step). World::advance asks only for a world whose guard has started, with
+  // no post-step effect and no timer, and for no more steps than reach the guard's next energy
+  // check. A state that fails the guard's test before the first step throws the guard's error
+  // before anything moves; a step that leaves one is the last taken (within false: the world
+  // then lets the guard throw). {} declines: nothing changed, not even the effects' time.
+  virtual BackendSteps steps(World& /*world*/, double /*dt*/, long /*count*/) { return {}; }
+
   // The potential energy of `effect`, one of world's force effects, at x, as
   // effect.potential_energy(world.particles, x) computes it, bit for bit. False: declined, and
   // `energy` is untouched.

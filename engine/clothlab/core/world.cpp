@@ -57,6 +57,29 @@ void World::step(double dt) {
   if (steps % guard.energy_check_every == 0) guard.check_energy(*this);
 }
 
+void World::advance(double dt, long count) {
+  while (count > 0) {
+    // The first step starts the guard; a timed step (--stats) and a post-step effect stay the
+    // world's own.
+    if (steps == 0 || !backend || timer || !post_step_effects.empty()) {
+      step(dt);
+      --count;
+      continue;
+    }
+    // As far as the guard's next energy check, which reads the world's state.
+    const long every = std::max(1L, guard.energy_check_every);
+    const BackendSteps taken = backend->steps(*this, dt, std::min(count, every - steps % every));
+    if (taken.taken == 0) {  // declined: the rest one step at a time
+      for (; count > 0; --count)
+        step(dt);
+      return;
+    }
+    count -= taken.taken;
+    if (!taken.within) guard.check(*this, /*before_step=*/false);  // names the particle, throws
+    if (steps % guard.energy_check_every == 0) guard.check_energy(*this);
+  }
+}
+
 void World::record_step_start() {
   for (const auto& effect : post_step_effects)
     effect->before_step(*this);

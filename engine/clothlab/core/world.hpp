@@ -70,6 +70,11 @@ class World {
 
   // Takes one step of dt [s] (steps 1-5 and the substep contract above).
   void step(double dt);
+  // Takes `count` steps of dt [s]: the same as calling step(dt) `count` times, bit for bit, the
+  // guard's checks and errors included. A backend may take several at once without handing the
+  // state back between them (Backend::steps), for a world with no post-step effect; nothing
+  // outside the world may read or change its particles until advance returns.
+  void advance(double dt, long count);
 
   // Every post-step effect records what it needs of the state the step starts from
   // (PostStepEffect::before_step). step() calls it when no backend takes the step; a backend

@@ -1,0 +1,190 @@
+// World::advance: steps taken several at once, the state kept in the engine room's layout between
+// them (engine/fast/resident.hpp), are the steps World::step takes one at a time, bit for bit:
+// the state, the forces, the time, the counts and the guard's errors.
+#include <doctest/doctest.h>
+
+#include <string>
+#include <vector>
+
+#include "clothlab/core/guard.hpp"
+#include "fast_util.hpp"
+
+using clothlab::Index;
+
+namespace {
+
+// A hanging cloth in a gusty wind (a force that changes with time: each step must be told its
+// own), in `precision`, with `method`.
+std::string windy_cloth(const std::string& method, const std::string& precision,
+                        const std::string& extra = "") {
+  return test::hanging_cloth(24, 21) +
+         "[aerodynamics]\nwind = [6, 0, 2]\ngust = [3, 0, 1]\ngust_period = 0.05\n"
+         "[integrator]\nmethod = \"" +
+         method + "\"\ndt = 0.0005\nduration = 1.0\n" + extra + "[engine]\nprecision = \"" +
+         precision + "\"\n";
+}
+
+struct Run {
+  clothlab::Scene scene;
+  long wakes = 0;
+};
+
+// The scene on `threads` threads: one step, then `count` steps, at once (advance) or one at a time.
+Run stepped(const std::string& text, int threads, long count, bool at_once, bool fast = true) {
+  Run run{clothlab::parse_scene(text, "advance.toml")};
+  clothlab::World& world = run.scene.world;
+  if (!fast) world.backend.reset();
+  world.threads = threads;
+  world.step(run.scene.dt);
+  const long before = world.thread_wakes();
+  if (at_once) {
+    world.advance(run.scene.dt, count);
+  } else {
+    for (long s = 0; s < count; ++s)
+      world.step(run.scene.dt);
+  }
+  run.wakes = world.thread_wakes() - before;
+  return run;
+}
+
+void check_same(const clothlab::World& a, const clothlab::World& b) {
+  CHECK(test::identical(a.particles.x, b.particles.x));
+  CHECK(test::identical(a.particles.v, b.particles.v));
+  CHECK(test::identical(a.particles.f, b.particles.f));
+  CHECK(a.t == b.t);
+  CHECK(a.steps == b.steps);
+  CHECK(a.force_evaluations == b.force_evaluations);
+}
+
+// The SimulationError the scene's steps end with, and the world they leave.
+struct Stop {
+  long step = -1;
+  Index particle = -1;
+  std::string message;
+};
+
+Stop stop_of(clothlab::World& world, double dt, long count, bool at_once) {
+  Stop stop;
+  try {
+    if (at_once) {
+      world.advance(dt, count);
+    } else {
+      for (long s = 0; s < count; ++s)
+        world.step(dt);
+    }
+  } catch (const clothlab::SimulationError& e) {
+    stop = {e.step(), e.particle(), e.what()};
+  }
+  return stop;
+}
+
+}  // namespace
+
+TEST_CASE("advance: steps at once are the steps one at a time, bit for bit, in double and float") {
+  // 100 steps after the first cross the guard's energy checks at 32, 64 and 96: the run of steps
+  // stops at each, hands the state back for the check, and goes on.
+  for (const std::string method : {"symplectic-euler", "explicit-euler"}) {
+    for (const std::string precision : {"double", "float"}) {
+      CAPTURE(method);
+      CAPTURE(precision);
+      const std::string text = windy_cloth(method, precision);
+      // Double: against the lecture's path itself; float: against the float room's steps.
+      const Run one = stepped(text, 1, 100, false, precision == "float");
+      for (int threads = 1; threads <= 4; ++threads) {
+        CAPTURE(threads);
+        const Run at_once = stepped(text, threads, 100, true);
+        check_same(at_once.scene.world, one.scene.world);
+        if (threads == 1) continue;
+        // It did keep the state between steps: one wake for each run of steps (four, between
+        // the checks) and for each energy check's spring sets, where one at a time wakes the
+        // threads at every step.
+        const Run each = stepped(text, threads, 100, false);
+        check_same(each.scene.world, one.scene.world);
+        CHECK(each.wakes >= 100);
+        CHECK(at_once.wakes < 20);
+      }
+    }
+  }
+}
+
+TEST_CASE("advance: a split of the particles between threads changes no bit") {
+  const std::string text = windy_cloth("symplectic-euler", "double");
+  const Run one = stepped(text, 1, 40, false, false);
+  clothlab::Scene scene = clothlab::parse_scene(text, "advance.toml");
+  clothlab::World& world = scene.world;
+  world.threads = 3;
+  world.step(scene.dt);
+  const Index n = world.particles.size();
+  // Uneven, an empty piece, a piece of one particle: between and within the runs of steps.
+  const std::vector<std::vector<Index>> splits{{0, 0, 1, n}, {0, n / 5, n - 3, n}, {0, 7, 300, n}};
+  for (const auto& split : splits) {
+    world.set_particle_bounds(split);
+    world.advance(scene.dt, 13);
+  }
+  world.advance(scene.dt, 1);
+  check_same(world, one.scene.world);
+}
+
+TEST_CASE("advance: the guard stops a run of steps where it stops the steps one at a time") {
+  // ks = 6000 N/m with dt = 2 ms: far past symplectic Euler's limit, the cloth blows up. With the
+  // energy check set aside, the bounds the move checks stop it, at the step that crossed them.
+  for (const std::string precision : {"double", "float"}) {
+    CAPTURE(precision);
+    std::string text =
+        windy_cloth("symplectic-euler", precision, "[guard]\nmax_energy_growth = 1e300\n");
+    text.replace(text.find("ks = 60"), 7, "ks = 6000");
+    text.replace(text.find("dt = 0.0005"), 11, "dt = 0.002");
+    for (int threads : {1, 2}) {
+      CAPTURE(threads);
+      clothlab::Scene a = clothlab::parse_scene(text, "advance.toml");
+      clothlab::Scene b = clothlab::parse_scene(text, "advance.toml");
+      a.world.threads = b.world.threads = threads;
+      a.world.step(a.dt);
+      b.world.step(b.dt);
+      const Stop at_once = stop_of(a.world, a.dt, 500, true);
+      const Stop each = stop_of(b.world, b.dt, 500, false);
+      CAPTURE(at_once.message);
+      REQUIRE(each.step > 1);
+      CHECK(each.step < 500);
+      CHECK(at_once.step == each.step);
+      CHECK(at_once.particle == each.particle);
+      CHECK(at_once.message == each.message);
+      check_same(a.world, b.world);
+    }
+  }
+}
+
+TEST_CASE("advance: a state bad before the steps is the guard's error, and nothing moves") {
+  for (const std::string precision : {"double", "float"}) {
+    CAPTURE(precision);
+    const std::string text = windy_cloth("symplectic-euler", precision);
+    clothlab::Scene a = clothlab::parse_scene(text, "advance.toml");
+    clothlab::Scene b = clothlab::parse_scene(text, "advance.toml");
+    for (clothlab::Scene* scene : {&a, &b}) {
+      scene->world.threads = 2;
+      scene->world.step(scene->dt);
+      scene->world.particles.x(1, 100) = 1e9;  // dragged far off between two steps
+    }
+    const clothlab::Matrix3X x = a.world.particles.x;
+    const Stop at_once = stop_of(a.world, a.dt, 10, true);
+    const Stop each = stop_of(b.world, b.dt, 10, false);
+    CAPTURE(at_once.message);
+    CHECK(at_once.particle == 100);
+    CHECK(at_once.step == each.step);
+    CHECK(at_once.message == each.message);
+    CHECK(test::identical(a.world.particles.x, x));
+    CHECK(a.world.steps == 1);
+  }
+}
+
+TEST_CASE("advance: a world with a post-step effect takes its steps one at a time, the same") {
+  // A ground: the steps are the world's own (its contacts read the world's state); the result
+  // is still that of step().
+  const std::string text = test::hanging_cloth(16, 16) +
+                           "[ground]\ny = -0.2\n[integrator]\nmethod = "
+                           "\"symplectic-euler\"\ndt = 0.001\nduration = 1.0\n";
+  const Run one = stepped(text, 1, 300, false, false);
+  const Run at_once = stepped(text, 2, 300, true);
+  check_same(at_once.scene.world, one.scene.world);
+  CHECK(at_once.wakes >= 300);
+}
