@@ -213,17 +213,27 @@ double eigenvalue_dt_limit(std::string_view integrator, double omega, double bet
   };
   // Stable: no eigenvalue outside the unit circle (beyond rounding).
   const auto stable = [&](double y) { return rho(y) <= 1.0 + 1e-12; };
+  // A step visibly loses amplitude: its largest eigenvalue below 1 by more than rounding. Or,
+  // on a heavily overdamped spring, whose slow mode loses less than rounding a step while its
+  // fast one dies out at once: every eigenvalue within the circle and their product (det M, the
+  // factor by which a step shrinks an area of states) below 1 by more than rounding. A method
+  // unstable at every dt has det M >= 1 (explicit Euler 1 + y^2, midpoint 1 + y^4 / 4).
+  const auto shrinks = [&](double y) {
+    const Matrix m = oscillator_step_matrix(integrator, y, 1.0, b);
+    const double r = spectral_radius(m);
+    return r < 1.0 - 1e-14 || (r <= 1.0 + 1e-12 && std::abs(m.determinant()) < 1.0 - 1e-14);
+  };
   // At y = 0.01 the growth of undamped explicit Euler (y^2 / 2 a step) and midpoint (y^4 / 8)
   // still shows above rounding. A damped method unstable there may be stable further down
-  // (explicit Euler below y = 2 zeta, midpoint below about y = 2 zeta^(1/3)): halve y until a
-  // step visibly loses amplitude (rho below 1 by more than rounding), or call the method
-  // unstable at every dt once y is below 1e-9.
+  // (explicit Euler below y = 2 zeta, midpoint below about y = 2 zeta^(1/3), symplectic Euler
+  // below y = 2 / (2 zeta) on a spring damped far past critical): halve y until a step visibly
+  // shrinks the motion, or call the method unstable at every dt once y is below 1e-30.
   double lo = 1e-2;
   if (!stable(lo)) {
     do {
       lo *= 0.5;
-      if (lo < 1e-9) return 0.0;
-    } while (!(rho(lo) < 1.0 - 1e-14));
+      if (lo < 1e-30) return 0.0;
+    } while (!shrinks(lo));
   }
   // Up in steps of 10 % to the first unstable y, then bisect between the last two.
   double hi = 1.1 * lo;
@@ -324,15 +334,19 @@ TimeStepAdvice advise_time_step(const World& world, double dt, long steps) {
         dt, method, round_down(advice.dt_limit), mode, growth, steps);
   } else {
     why = fmt::format(
-        "{} adds energy at every step on undamped springs: at dt = {} s {} would grow by a "
+        "{} adds energy at every step on {} springs: at dt = {} s {} would grow by a "
         "factor of {} over the run's {} steps",
-        method, dt, mode, growth, steps);
+        method, b.beta_max > 0.0 ? "these" : "undamped", dt, mode, growth, steps);
   }
+  // A dt that small may be none a double can hold (a damping of 1e40 1/s): then no dt to offer.
+  const std::string smaller = suggested > 0.0
+                                  ? fmt::format("dt <= {} s ({:.0f} times smaller), or ",
+                                                round_down(suggested), std::ceil(dt / suggested))
+                                  : std::string();
+  const bool offer_symplectic = advice.dt_limit == 0.0 && method != "symplectic-euler";
   advice.warning = fmt::format(
-      "{}. Take dt <= {} s ({:.0f} times smaller), or method = \"implicit-euler\", which "
-      "is stable at any dt{}",
-      why, round_down(suggested), std::ceil(dt / suggested),
-      advice.dt_limit > 0.0 ? "" : ", or \"symplectic-euler\", which keeps energy bounded");
+      "{}. Take {}method = \"implicit-euler\", which is stable at any dt{}", why, smaller,
+      offer_symplectic ? ", or \"symplectic-euler\", which keeps energy bounded" : "");
   return advice;
 }
 

@@ -112,6 +112,32 @@ TEST_CASE("advisor: damped limits match dt^2 k + 2 dt c = 4 m and dt = c / k") {
   }
 }
 
+TEST_CASE("advisor: a spring damped far past critical has symplectic Euler's limit, not none") {
+  // zeta up to 1e20: the slow mode loses less than rounding a step at the limit, the fast one
+  // dies at once. The limit is still the positive root of k dt^2 + 2 c dt - 4 m = 0, about
+  // 2 m / c, and the advice says so, without offering the method it has.
+  const double k = 100.0, m = 1.0;
+  for (double c : {1e4, 1e8, 1e12, 1e16, 1e20}) {
+    CAPTURE(c);
+    const double root = 4.0 * m / (c + std::sqrt(c * c + 4.0 * k * m));  // the same root, stably
+    const double limit = clothlab::oscillator_dt_limit("symplectic-euler", std::sqrt(k / m), c / m);
+    CHECK(limit == doctest::Approx(root).epsilon(1e-6));
+    World world = test::anchored_spring(m, k, c, 0.01, 0.0);
+    world.integrator = clothlab::make_integrator("symplectic-euler");
+    const clothlab::TimeStepAdvice advice = clothlab::advise_time_step(world, 1e-3, 200);
+    CAPTURE(advice.warning);
+    CHECK(advice.dt_limit == doctest::Approx(root).epsilon(1e-6));
+    CHECK(advice.warning.find("above the stability limit of symplectic-euler") !=
+          std::string::npos);
+    CHECK(advice.warning.find("\"symplectic-euler\", which keeps") == std::string::npos);
+  }
+  // Undamped explicit Euler and midpoint stay unstable at every dt.
+  for (const char* method : {"explicit-euler", "midpoint"}) {
+    CAPTURE(method);
+    CHECK(clothlab::eigenvalue_dt_limit(method, 10.0, 0.0) == 0.0);
+  }
+}
+
 TEST_CASE("advisor: Gershgorin's bound is exact for one spring and a free pair") {
   // One spring to a pinned anchor: w = sqrt(k / m).
   World anchored = oscillator("symplectic-euler", 12.0, 0.0, 0.0, 0.0);
