@@ -396,9 +396,21 @@ int main(int argc, char** argv) {
       return 0;
     }
     if (*repair_cmd) {
-      const long frames = cut_to_common_frames(repair_dir);
-      fmt::print("{}: every file holds frames 0 to {} ({} frames)\n", shown(repair_dir), frames - 1,
-                 frames);
+      long frames = 0;
+      try {
+        frames = cut_to_common_frames(repair_dir);
+      } catch (const OutputError& error) {
+        // A folder that is not a run's, or a file it cannot read: refused, as a run refuses a
+        // folder of the user's, before anything is cut.
+        fmt::print(stderr, "error: {}\n", shown(error.what()));
+        return app::kExitBadInput;
+      }
+      if (frames == 0) {
+        fmt::print("{}: every file holds no frame, only its header\n", shown(repair_dir));
+      } else {
+        fmt::print("{}: every file holds frames 0 to {} ({} frames)\n", shown(repair_dir),
+                   frames - 1, frames);
+      }
       return 0;
     }
     if (app.get_subcommands().empty()) {

@@ -6,33 +6,52 @@
 
 #include <algorithm>
 #include <cerrno>
+#include <charconv>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <limits>
+#include <string>
 #include <string_view>
+#include <utility>
+#include <vector>
 
 #include <fmt/format.h>
 
 #include "clothlab/core/guard.hpp"
+#include "io/run_folder.hpp"
 
 #include "clothlab/forces/spring_damper.hpp"
 
 namespace clothlab {
+
+namespace {
+
+// The first line of each file, as FrameWriter writes it and `repair` reads it.
+constexpr std::string_view kEnergyHeader = "frame,t,kinetic,potential,total,px,py,pz";
+constexpr std::string_view kPositionsHeader = "frame,t,particle,x,y,z";
+constexpr std::string_view kVelocitiesHeader = "frame,t,particle,vx,vy,vz";
+constexpr std::string_view kSpringsHeader = "frame,t,effect,spring,i,j,strain,tension";
+
+std::string with_newline(std::string_view text) {
+  return std::string(text) + "\n";
+}
+
+}  // namespace
 
 FrameWriter::FrameWriter(const Folder& dir, bool velocities, bool springs, bool npy,
                          Index particles, bool page)
     : page_(page) {
   files_ = {dir.path() / "energy.csv"};
   energy_ = AppendFile(dir, "energy.csv");
-  energy_.append("frame,t,kinetic,potential,total,px,py,pz\n");
+  energy_.append(with_newline(kEnergyHeader));
   if (npy) {
     files_.push_back(dir.path() / "positions.npy");
     positions_npy_.emplace(dir, "positions.npy", particles);
   } else {
     files_.push_back(dir.path() / "positions.csv");
     positions_ = AppendFile(dir, "positions.csv");
-    positions_.append("frame,t,particle,x,y,z\n");
+    positions_.append(with_newline(kPositionsHeader));
   }
   if (velocities && npy) {
     files_.push_back(dir.path() / "velocities.npy");
@@ -40,12 +59,12 @@ FrameWriter::FrameWriter(const Folder& dir, bool velocities, bool springs, bool 
   } else if (velocities) {
     files_.push_back(dir.path() / "velocities.csv");
     velocities_ = AppendFile(dir, "velocities.csv");
-    velocities_.append("frame,t,particle,vx,vy,vz\n");
+    velocities_.append(with_newline(kVelocitiesHeader));
   }
   if (springs) {
     files_.push_back(dir.path() / "springs.csv");
     springs_ = AppendFile(dir, "springs.csv");
-    springs_.append("frame,t,effect,spring,i,j,strain,tension\n");
+    springs_.append(with_newline(kSpringsHeader));
   }
 }
 
@@ -181,103 +200,232 @@ void FrameWriter::write(const World& world, long frame, long step) {
 
 namespace {
 
-// The size to cut the CSV file `fd` back to so that it holds its header and its rows of frames
-// below `frames`, and no cut line: the rows are in frame order, the frame their first field.
-off_t csv_size_for(int fd, long frames) {
+// What `repair` reads of a CSV file of frames: where each frame's rows end, and how many frames
+// it holds whole.
+struct CsvFrames {
+  off_t header_end = 0;          // the size of the file with its header alone
+  std::vector<off_t> frame_end;  // frame_end[f]: with the rows of frames 0 to f
+  long whole = 0;                // frames held whole
+  // The size that holds the header and the rows of the first `frames` frames (no more than it
+  // has), and no cut line.
+  off_t size_for(long frames) const {
+    return frames == 0 ? header_end : frame_end[static_cast<size_t>(frames - 1)];
+  }
+};
+
+// Reads the CSV file `fd` (`path`) of frames: its first line must be `header`, each whole row after
+// it a row of the frame it is in or of the next, from frame 0 on (with `one_row`, one row a frame,
+// as energy.csv). A line without its '\n' at the end is a cut line, which is not read.
+// The rows of a whole frame end in the same row as the frame before it, the row named by the
+// fields `key` (a particle: particles 0 to N - 1; a spring's effect, i and j: the springs in
+// their order, less those torn since), so a last frame that ends in another row is cut short (a
+// torn last spring makes it look so: a whole frame cut, never a cut frame kept); a first frame
+// has none before it and is taken whole. Throws OutputError for a file it cannot read so.
+CsvFrames read_csv_frames(int fd, const std::filesystem::path& path, std::string_view header,
+                          const std::vector<size_t>& key, bool one_row) {
+  const auto unreadable = [&](const std::string& why) {
+    return OutputError(
+        fmt::format("{} is not a file of frames as clothlab writes it: {}; repair cut nothing",
+                    path.string(), why));
+  };
+  constexpr size_t kLongestLine = 4096;  // clothlab's rows are a few hundred bytes at most
   constexpr size_t kBlock = 1 << 20;
   std::string block(kBlock, '\0');
-  off_t at = 0, line_start = 0;
-  std::string first_field;  // of the line being read
-  bool in_first_field = true, header = true;
+  CsvFrames frames;
+  std::string line, row_key, last_key, previous_key;
+  bool header_read = false, too_long = false;
+  long line_number = 0;
+  off_t at = 0;
   for (;;) {
     const ssize_t got = ::pread(fd, block.data(), block.size(), at);
-    if (got <= 0) return line_start;  // the end: a line without its '\n' is cut off
+    if (got < 0) throw unreadable(system_reason(errno));
+    if (got == 0) break;
     for (ssize_t k = 0; k < got; ++k) {
       const char c = block[static_cast<size_t>(k)];
-      if (c == '\n') {
-        const off_t next = at + k + 1;
-        if (!header) {
-          char* end = nullptr;
-          const long frame = std::strtol(first_field.c_str(), &end, 10);
-          if (first_field.empty() || *end != '\0' || frame >= frames) return line_start;
-        }
-        header = false;
-        line_start = next;
-        first_field.clear();
-        in_first_field = true;
-      } else if (in_first_field) {
-        if (c == ',') {
-          in_first_field = false;
+      if (c != '\n') {
+        if (line.size() < kLongestLine) {
+          line += c;
         } else {
-          first_field += c;
+          too_long = true;
         }
+        continue;
       }
+      ++line_number;
+      const off_t end = at + k + 1;
+      if (too_long) throw unreadable(fmt::format("line {} is too long for a row", line_number));
+      if (!header_read) {
+        if (line != header) {
+          throw unreadable(fmt::format("its first line is not the header \"{}\"", header));
+        }
+        header_read = true;
+        frames.header_end = end;
+        line.clear();
+        continue;
+      }
+      // The fields: the frame, t, then the key's.
+      std::vector<std::string_view> fields;
+      for (size_t from = 0;;) {
+        const size_t comma = line.find(',', from);
+        fields.emplace_back(std::string_view(line).substr(from, comma - from));
+        if (comma == std::string::npos) break;
+        from = comma + 1;
+      }
+      long frame = -1;
+      const std::string_view first = fields.front();
+      const auto [rest, error] = std::from_chars(first.data(), first.data() + first.size(), frame);
+      const long current = static_cast<long>(frames.frame_end.size()) - 1;
+      if (error != std::errc() || rest != first.data() + first.size() ||
+          std::any_of(key.begin(), key.end(), [&](size_t f) { return f >= fields.size(); })) {
+        throw unreadable(fmt::format("line {} is not a row of a frame", line_number));
+      }
+      if (frame != current + 1 && (one_row || frame != current || current < 0)) {
+        throw unreadable(
+            fmt::format("line {} is a row of frame {} after {}", line_number, frame,
+                        current < 0 ? "the header" : fmt::format("frame {}", current)));
+      }
+      row_key.clear();
+      for (const size_t f : key)
+        row_key.append(fields[f]).append(",");
+      if (frame != current) {
+        previous_key = std::exchange(last_key, row_key);
+        frames.frame_end.push_back(end);
+      } else {
+        last_key = row_key;
+        frames.frame_end.back() = end;
+      }
+      line.clear();
     }
     at += got;
   }
+  if (!header_read) throw unreadable("it holds no whole header line");
+  const long held = static_cast<long>(frames.frame_end.size());
+  frames.whole = one_row || held <= 1 || last_key == previous_key ? held : held - 1;
+  return frames;
+}
+
+// What `repair` reads of a .npy file of frames: its particles, and the frames it holds whole.
+struct NpyFrames {
+  long particles = 0;
+  long count = 0;  // frames its header counts
+  long whole = 0;  // frames it holds whole
+};
+
+NpyFrames read_npy_frames(int fd, const std::filesystem::path& path) {
+  const auto unreadable = [&](const std::string& why) {
+    return OutputError(
+        fmt::format("{} is not a file of frames as clothlab writes it: {}; repair cut nothing",
+                    path.string(), why));
+  };
+  std::string head(NpyFrameWriter::kHeaderBytes, '\0');
+  struct stat status {};
+  if (::fstat(fd, &status) != 0) throw unreadable(system_reason(errno));
+  if (::pread(fd, head.data(), head.size(), 0) != NpyFrameWriter::kHeaderBytes) {
+    throw unreadable("it is shorter than its header");
+  }
+  long count = 0, particles = 0;
+  const size_t shape = head.find("'shape': (");
+  // The header as NpyFrameWriter::header writes it, but for the numbers.
+  if (shape == std::string::npos ||
+      std::sscanf(head.c_str() + shape, "'shape': (%ld, %ld, 3)", &count, &particles) != 2 ||
+      count < 0 || particles < 1 || head != NpyFrameWriter::header(count, particles)) {
+    throw unreadable("its header is not that of 32-bit floats of shape (frames, particles, 3)");
+  }
+  const off_t frame_bytes = static_cast<off_t>(particles) * 3 * 4;
+  const off_t data = status.st_size - NpyFrameWriter::kHeaderBytes;
+  // The header counts a frame once its bytes are in (io/npy.hpp); a file cut shorter holds less.
+  return {particles, count, std::min(count, static_cast<long>(data / frame_bytes))};
 }
 
 }  // namespace
 
 long cut_to_common_frames(const std::filesystem::path& dir) {
   const Folder folder(dir, /*no_link=*/true);
-  const auto open = [&](const char* name) {
+  // Only a run's folder, and not while a run writes there.
+  const PageFolderLock lock = lock_run_folder(folder);
+  struct Descriptors {
+    std::vector<int> fds;
+    ~Descriptors() {
+      for (const int fd : fds)
+        ::close(fd);
+    }
+  } opened;
+  const auto open = [&](const char* name) -> int {
     const int fd = ::openat(folder.fd(), name, O_RDWR | O_NOFOLLOW | O_CLOEXEC);
     if (fd < 0 && errno != ENOENT) {
-      throw OutputError(
-          fmt::format("cannot open {}: {}", (dir / name).string(), system_reason(errno)));
+      throw OutputError(fmt::format("cannot open {}: {}; repair cut nothing", (dir / name).string(),
+                                    system_reason(errno)));
     }
+    if (fd >= 0) opened.fds.push_back(fd);
     return fd;
   };
+  // Every file is read before any is cut: a file repair cannot read leaves them all as they are.
+  const int energy = open("energy.csv");
+  if (energy < 0) {
+    throw OutputError(fmt::format("{} holds no energy.csv; repair cut nothing", dir.string()));
+  }
+  const CsvFrames energy_frames =
+      read_csv_frames(energy, dir / "energy.csv", kEnergyHeader, {}, /*one_row=*/true);
+  long frames = energy_frames.whole;
+  struct Csv {
+    const char* name;
+    std::string_view header;
+    std::vector<size_t> key;  // the fields that name a row: the particle; a spring's effect, i, j
+    int fd = -1;
+    CsvFrames read;
+  };
+  Csv csvs[] = {{"positions.csv", kPositionsHeader, {2}, -1, {}},
+                {"velocities.csv", kVelocitiesHeader, {2}, -1, {}},
+                {"springs.csv", kSpringsHeader, {2, 4, 5}, -1, {}}};
+  for (Csv& csv : csvs) {
+    csv.fd = open(csv.name);
+    if (csv.fd < 0) continue;
+    csv.read = read_csv_frames(csv.fd, dir / csv.name, csv.header, csv.key, false);
+    frames = std::min(frames, csv.read.whole);
+  }
+  struct Npy {
+    const char* name;
+    int fd = -1;
+    NpyFrames read;
+  };
+  Npy npys[] = {{"positions.npy", -1, {}}, {"velocities.npy", -1, {}}};
+  for (Npy& npy : npys) {
+    npy.fd = open(npy.name);
+    if (npy.fd < 0) continue;
+    npy.read = read_npy_frames(npy.fd, dir / npy.name);
+    frames = std::min(frames, npy.read.whole);
+  }
+  if (npys[0].fd >= 0 && npys[1].fd >= 0 && npys[0].read.particles != npys[1].read.particles) {
+    throw OutputError(fmt::format(
+        "{} holds frames of {} particles and {} of {}: they are not one run's files; repair cut "
+        "nothing",
+        (dir / npys[0].name).string(), npys[0].read.particles, (dir / npys[1].name).string(),
+        npys[1].read.particles));
+  }
+
   const auto cut = [&](int fd, off_t size, const char* name) {
     struct stat status {};
     if (::fstat(fd, &status) == 0 && status.st_size > size && ::ftruncate(fd, size) != 0) {
-      const int error = errno;
-      ::close(fd);
       throw OutputError(
-          fmt::format("cannot cut {} back: {}", (dir / name).string(), system_reason(error)));
+          fmt::format("cannot cut {} back: {}", (dir / name).string(), system_reason(errno)));
     }
-    ::close(fd);
   };
-  // energy.csv takes each frame last (FrameWriter::write): its whole rows are the frames that
-  // every other file holds.
-  const int energy = open("energy.csv");
-  if (energy < 0) throw OutputError(fmt::format("{} holds no energy.csv", dir.string()));
-  const off_t energy_size = csv_size_for(energy, std::numeric_limits<long>::max());
-  long frames = 0;
-  {
-    std::string text(static_cast<size_t>(energy_size), '\0');
-    if (::pread(energy, text.data(), text.size(), 0) != static_cast<ssize_t>(text.size())) {
-      ::close(energy);
-      throw OutputError(fmt::format("cannot read {}", (dir / "energy.csv").string()));
-    }
-    frames = std::count(text.begin(), text.end(), '\n') - 1;  // the rows below the header
+  // energy.csv first, as a run writes it last: if repair itself is stopped, its rows are still
+  // frames every other file holds.
+  cut(energy, energy_frames.size_for(frames), "energy.csv");
+  for (const Csv& csv : csvs) {
+    if (csv.fd >= 0) cut(csv.fd, csv.read.size_for(frames), csv.name);
   }
-  frames = std::max(frames, 0L);
-  cut(energy, energy_size, "energy.csv");
-  for (const char* name : {"positions.csv", "velocities.csv", "springs.csv"}) {
-    if (const int fd = open(name); fd >= 0) cut(fd, csv_size_for(fd, frames), name);
-  }
-  for (const char* name : {"positions.npy", "velocities.npy"}) {
-    const int fd = open(name);
-    if (fd < 0) continue;
-    std::string head(NpyFrameWriter::kHeaderBytes, '\0');
-    const bool read = ::pread(fd, head.data(), head.size(), 0) == NpyFrameWriter::kHeaderBytes;
-    long held = 0, particles = 0;
-    const size_t shape = head.find("'shape': (");
-    if (!read || shape == std::string::npos ||
-        std::sscanf(head.c_str() + shape, "'shape': (%ld, %ld, 3)", &held, &particles) != 2) {
-      ::close(fd);
+  for (const Npy& npy : npys) {
+    if (npy.fd < 0) continue;
+    const std::string header = NpyFrameWriter::header(frames, npy.read.particles);
+    if (npy.read.count != frames &&
+        ::pwrite(npy.fd, header.data(), header.size(), 0) != static_cast<ssize_t>(header.size())) {
       throw OutputError(
-          fmt::format("{} is not a file of frames clothlab wrote", (dir / name).string()));
+          fmt::format("cannot write {}: {}", (dir / npy.name).string(), system_reason(errno)));
     }
-    const long keep = std::min(held, frames);
-    const std::string header = NpyFrameWriter::header(keep, particles);
-    if (::pwrite(fd, header.data(), header.size(), 0) != static_cast<ssize_t>(header.size())) {
-      ::close(fd);
-      throw OutputError(fmt::format("cannot write {}", (dir / name).string()));
-    }
-    cut(fd, NpyFrameWriter::kHeaderBytes + static_cast<off_t>(keep) * particles * 3 * 4, name);
+    cut(npy.fd,
+        NpyFrameWriter::kHeaderBytes + static_cast<off_t>(frames) * npy.read.particles * 3 * 4,
+        npy.name);
   }
   return frames;
 }

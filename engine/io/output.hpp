@@ -60,8 +60,13 @@ class FrameWriter {
 // After a run that was killed (SIGKILL, a crash, a power cut: no chance to cut anything back),
 // the files may end on different frames, one of them in a cut line: each frame goes to the other
 // files first and to energy.csv last, so energy.csv's whole rows are the frames every file
-// holds. Cuts every file in `dir` back to those frames (and a .npy's count with them); returns
-// how many. Throws OutputError naming a file it cannot read or cut. `clothlab repair DIR`.
+// holds (after a power cut, which may lose what the system had not yet put on disk, a file may
+// hold fewer). Cuts every file in `dir` back to the frames all of them hold whole (and a .npy's
+// count with them); returns how many. Only in a run's folder (its marker, io/run_folder.hpp),
+// and not while a run writes there. Throws OutputError, and cuts nothing, for a folder that is
+// not a run's or a file it cannot read as clothlab writes it (a header that is not clothlab's, a
+// row out of frame order, .npy files of different particle counts); throws OutputError naming a
+// file it cannot cut. `clothlab repair DIR`.
 long cut_to_common_frames(const std::filesystem::path& dir);
 
 }  // namespace clothlab

@@ -48,6 +48,49 @@ std::string signal_name(int signal) {
   return abbreviation ? fmt::format("SIG{}", abbreviation) : fmt::format("signal {}", signal);
 }
 
+// Where `path` is, so that two spellings of one place compare equal: absolute, the links of the
+// part that exists followed, without "." or ".." or a trailing slash ("out/", "./out" and
+// "$PWD/out" are one folder).
+std::filesystem::path place_of(const std::filesystem::path& path) {
+  std::error_code ec;
+  const std::filesystem::path absolute = std::filesystem::absolute(path.empty() ? "." : path, ec);
+  std::filesystem::path place = ec ? path : std::filesystem::weakly_canonical(absolute, ec);
+  if (ec) place = absolute.lexically_normal();
+  return !place.has_filename() && place.has_parent_path() ? place.parent_path() : place;
+}
+
+bool same_place(const std::filesystem::path& a, const std::filesystem::path& b) {
+  return place_of(a) == place_of(b);
+}
+
+// Throws OutputError if the page `html` would take the place of the run's own files in `dir`:
+// the folder itself or a folder that holds it (the page is a file: the run's folder could not
+// be made, or the page not written once the frames are), or, inside the folder (`inside`), a
+// name the run writes its data under, or its marker. The page would replace the data at the end
+// of the run, or be cleared as the last run's output by the next one.
+void check_page_place(const std::filesystem::path& html, const std::filesystem::path& dir,
+                      bool inside) {
+  const std::filesystem::path page = place_of(html), folder = place_of(dir);
+  const auto [p, f] = std::mismatch(page.begin(), page.end(), folder.begin(), folder.end());
+  if (p == page.end()) {
+    throw OutputError(fmt::format(
+        "--html {} is {} --out folder {}, and the page is a file beside the run's data; choose "
+        "another --html, such as {}",
+        html.string(), f == folder.end() ? "the" : "a folder that holds the", dir.string(),
+        (dir / "view.html").string()));
+  }
+  const std::string name = html.filename().string();
+  const bool own = name == kRunFolderMarker ||
+                   (name != "view.html" && std::find(kRunOutputNames.begin(), kRunOutputNames.end(),
+                                                     name) != kRunOutputNames.end());
+  if (inside && own) {
+    throw OutputError(fmt::format(
+        "--html {} is the run's own {} in --out {}, and the page would replace it; choose "
+        "another --html, such as {}",
+        html.string(), name, dir.string(), (dir / "view.html").string()));
+  }
+}
+
 }  // namespace
 
 StopSignals::StopSignals() {
@@ -96,16 +139,14 @@ RunReport run_scene(Scene& scene, const RunOutputs& outputs, const ProgressFn& p
   StopSignals stop_signals;
   // Everything that can be found wrong with the outputs is found before the first step.
   const bool page = !outputs.html.empty();
-  // A page outside the folder is checked first, so that a bad --html creates no folder.
-  const auto folder_of = [](std::filesystem::path p) {  // "out/" and "./out" are "out"
-    p = p.lexically_normal();
-    return !p.has_filename() && p.has_parent_path() ? p.parent_path() : p;
-  };
-  const bool page_inside = page && folder_of(outputs.html.parent_path()) == folder_of(outputs.dir);
+  // A page outside the folder is checked first, so that a bad --html creates no folder; a page
+  // inside it is checked by RunFolder, before it clears anything there.
+  const bool page_inside = page && same_place(outputs.html.parent_path(), outputs.dir);
+  if (page) check_page_place(outputs.html, outputs.dir, page_inside);
   const PageFolderLock page_lock =
       page && !page_inside ? check_page_target(outputs.html, outputs.force) : PageFolderLock();
-  RunFolder folder(outputs.dir, outputs.force);
-  if (page_inside) check_page_target(outputs.html, outputs.force, /*lock_folder=*/false);
+  RunFolder folder(outputs.dir, outputs.force,
+                   page_inside ? outputs.html : std::filesystem::path());
   FrameWriter writer(folder.folder(), outputs.velocities || scene.output.velocities,
                      outputs.springs || scene.output.springs, outputs.npy || scene.output.npy,
                      scene.world.particles.size(), page);

@@ -108,6 +108,8 @@ void clear_last_run(const Folder& dir) {
         }
       }
       ::unlinkat(dir.fd(), name.c_str(), AT_REMOVEDIR);  // only if now empty: a user's file stays
+    } else if (name == "frames" && !S_ISLNK(status.st_mode)) {
+      continue;  // no run makes a file of that name: a user's, which RunFolder refuses to clear
     } else if ((is_output_name(name) || is_partial_file(name)) && !S_ISDIR(status.st_mode)) {
       remove(dir, name);
     }
@@ -177,9 +179,22 @@ int open_marker(const Folder& folder, bool create) {
   return fd;
 }
 
+// Throws OutputError if `frames` in `folder` is something a run neither makes nor may remove: a
+// run makes a folder there (or a link of that name is removed as a link), so a file of that name
+// is the user's, and clearing the last run's frames would delete it.
+void check_frames_name(const Folder& folder) {
+  struct stat status {};
+  if (::fstatat(folder.fd(), "frames", &status, AT_SYMLINK_NOFOLLOW) != 0) return;
+  if (S_ISDIR(status.st_mode) || S_ISLNK(status.st_mode)) return;
+  throw OutputError(fmt::format(
+      "{} is a file, not the folder of mesh frames (frames/frame_NNNN.obj) that a run keeps "
+      "there, and a run into {} would remove it; move or rename it, or choose another --out",
+      (folder.path() / "frames").string(), folder.path().string()));
+}
+
 }  // namespace
 
-RunFolder::RunFolder(fs::path dir, bool force) : dir_(std::move(dir)) {
+RunFolder::RunFolder(fs::path dir, bool force, const fs::path& page) : dir_(std::move(dir)) {
   const std::string shown = dir_.string();
   std::error_code ec;
   const fs::file_status status = fs::symlink_status(dir_, ec);
@@ -214,6 +229,17 @@ RunFolder::RunFolder(fs::path dir, bool force) : dir_(std::move(dir)) {
           shown, some_entries(names), kRunFolderMarker));
     }
   }
+  // What would refuse the run is found before the marker is made or rewritten and anything is
+  // cleared: a refused run leaves the folder as it was. A file or link under a name the run
+  // clears (view.html) is the last run's page, and goes with it.
+  check_frames_name(*folder_);
+  const std::string page_name = page.filename().string();
+  struct stat page_status {};
+  const bool cleared =
+      (is_output_name(page_name) || is_partial_file(page_name)) &&
+      ::fstatat(folder_->fd(), page_name.c_str(), &page_status, AT_SYMLINK_NOFOLLOW) == 0 &&
+      (S_ISREG(page_status.st_mode) || S_ISLNK(page_status.st_mode));
+  if (!page.empty() && !cleared) check_page_target(page, force, /*lock_folder=*/false);
 
   lock_fd_ = open_marker(*folder_, true);
   try {
@@ -252,6 +278,19 @@ bool holds_only_run_outputs(const fs::path& dir) {
 
 PageFolderLock::~PageFolderLock() {
   if (fd_ >= 0) ::close(fd_);
+}
+
+PageFolderLock lock_run_folder(const Folder& folder) {
+  const int marker = open_marker(folder, false);
+  if (marker < 0) {
+    throw OutputError(fmt::format(
+        "{} is not a clothlab output folder: it holds no {} marker, and repair cuts the files "
+        "there; nothing was cut",
+        folder.path().string(), kRunFolderMarker));
+  }
+  PageFolderLock lock(marker);
+  lock_marker(marker, folder.path() / kRunFolderMarker, folder.path().string(), "folder");
+  return lock;
 }
 
 PageFolderLock check_page_target(const fs::path& page, bool force, bool lock_folder) {

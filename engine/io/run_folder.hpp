@@ -6,7 +6,10 @@
 //     no marker is refused, unless the user forces it (`clothlab run --force`);
 //   - never leaves the last run's frames beside its own: it clears what the last run wrote
 //     (the names in kRunOutputNames, and frames/frame_NNNN.obj|vtk) before its first frame, and
-//     leaves anything else the user put there alone;
+//     leaves anything else the user put there alone (a file named `frames`, which no run makes,
+//     is refused: the folder of mesh frames has that name);
+//   - changes nothing in the folder when it is refused, for the folder or for a page that goes
+//     into it;
 //   - never shares the folder with another run at the same time: it holds a lock on the marker
 //     while it runs (the system lets the lock go when the process ends, however it ends);
 //   - never writes through a symbolic link: a run folder, a marker or an output that is a link
@@ -36,8 +39,11 @@ inline constexpr std::string_view kRunFolderMarker = ".clothlab-run";
 class RunFolder {
  public:
   // Takes `dir` for a run: creates it, or checks it is clothlab's (or empty, or `force`), locks
-  // it, and clears the last run's outputs. Throws OutputError saying what is wrong and what to do.
-  RunFolder(std::filesystem::path dir, bool force);
+  // it, and clears the last run's outputs. Throws OutputError saying what is wrong and what to do,
+  // and then has changed nothing in the folder: a `frames` that is not a folder (a user's file
+  // of that name, which clearing would lose) is refused, even with `force`, and so is `page`,
+  // the viewer page when it goes into this folder, as check_page_target refuses it.
+  RunFolder(std::filesystem::path dir, bool force, const std::filesystem::path& page = {});
   ~RunFolder();  // lets the lock go; the marker stays
   RunFolder(const RunFolder&) = delete;
   RunFolder& operator=(const RunFolder&) = delete;
@@ -69,11 +75,17 @@ class PageFolderLock {
   int fd_ = -1;
 };
 
+// Takes the run folder held open as `folder` for work on its files other than a run's
+// (`clothlab repair`): refuses a folder with no clothlab marker, as a run does without --force,
+// and one that a run writes into now, and returns the folder's lock, which keeps a run out
+// meanwhile. Throws OutputError saying what is wrong.
+PageFolderLock lock_run_folder(const Folder& folder);
+
 // Throws OutputError if `page` is an existing file that is not a clothlab viewer page (one that
 // starts as the template does), or a symbolic link, unless `force` (so --html cannot overwrite
 // a user's file by surprise); if no file can be written where it goes; or if it goes into
 // another run's folder while that run writes there. Returns the lock of that folder, when the
-// page goes into one and `lock_folder` (false for the run's own folder, locked already).
+// page goes into one and `lock_folder` (false for the run's own folder, which RunFolder locks).
 PageFolderLock check_page_target(const std::filesystem::path& page, bool force,
                                  bool lock_folder = true);
 

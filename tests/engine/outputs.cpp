@@ -724,3 +724,252 @@ TEST_CASE("outputs: after a SIGKILL every file is cut back to the frames all of 
     CHECK(clothlab::cut_to_common_frames(dir) == 21);  // a second time: nothing to do
   }
 }
+
+TEST_CASE("outputs: --html onto the run's own data, its marker or its folder is refused first") {
+  const fs::path dir = test::scratch_path("html-own");
+  // Refused before the first step, with a message that holds `why`.
+  const auto refused = [&](const fs::path& out, const fs::path& html, const std::string& why) {
+    clothlab::Scene scene = clothlab::parse_scene(kCloth, "<cloth>");
+    clothlab::RunOutputs outputs = clothlab::RunOutputs::in(out);
+    outputs.html = html;
+    CHECK_THROWS_WITH_AS(clothlab::run_scene(scene, outputs), doctest::Contains(why.c_str()),
+                         OutputError);
+    CHECK(scene.world.t == 0.0);
+  };
+  // A new folder: the page would replace positions.csv at the end of the run; the folder itself,
+  // or one that holds it, could not be the page.
+  const fs::path fresh = dir / "fresh";
+  refused(fresh, fresh / "positions.csv",
+          "--html " + (fresh / "positions.csv").string() + " is the run's own positions.csv in " +
+              "--out " + fresh.string() + ", and the page would replace it; choose another " +
+              "--html, such as " + (fresh / "view.html").string());
+  refused(fresh, fresh,
+          "--html " + fresh.string() + " is the --out folder " + fresh.string() +
+              ", and the page is a file beside the run's data; choose another --html, such as " +
+              (fresh / "view.html").string());
+  refused(fresh, fresh.string() + "/", "is the --out folder");
+  refused(fresh / "deeper", fresh, "is a folder that holds the --out folder");
+  CHECK_FALSE(fs::exists(fresh));
+
+  // A run's folder: its data, marker and page are as they were.
+  {
+    clothlab::Scene scene = clothlab::parse_scene(kCloth, "<cloth>");
+    clothlab::RunOutputs outputs = clothlab::RunOutputs::in(dir / "run");
+    outputs.velocities = true;
+    clothlab::run_scene(scene, outputs);
+  }
+  const std::vector<std::string> names = {".clothlab-run", "energy.csv", "positions.csv",
+                                          "velocities.csv", "view.html"};
+  std::vector<std::string> before;
+  for (const std::string& name : names)
+    before.push_back(read_all(dir / "run" / name));
+  for (const std::string name : {"energy.csv", "velocities.csv", "springs.csv", ".clothlab-run"}) {
+    CAPTURE(name);
+    // Spelt another way than --out, the same folder.
+    refused(dir / "run", dir / "run" / "." / name, "is the run's own " + name + " in --out");
+  }
+  CHECK(names_in(dir / "run") == names);
+  for (size_t k = 0; k < names.size(); ++k)
+    CHECK_MESSAGE(read_all(dir / "run" / names[k]) == before[k], names[k]);
+}
+
+TEST_CASE("outputs: a run refused for its page or a file named frames changes nothing there") {
+  const fs::path dir = test::scratch_path("refused-unchanged");
+  const auto run = [&](const fs::path& html, bool obj = false) {
+    clothlab::Scene scene = clothlab::parse_scene(kCloth, "<cloth>");
+    clothlab::RunOutputs outputs = clothlab::RunOutputs::in(dir);
+    if (!html.empty()) outputs.html = html;
+    outputs.obj = obj;
+    return clothlab::run_scene(scene, outputs);
+  };
+  run({});
+  write_text(dir / "notes.txt", "mine\n");
+  const std::vector<std::string> names = {".clothlab-run", "energy.csv", "notes.txt",
+                                          "positions.csv", "view.html"};
+  std::vector<std::string> before;
+  for (const std::string& name : names)
+    before.push_back(read_all(dir / name));
+  const auto unchanged = [&] {
+    CHECK(names_in(dir) == names);
+    for (size_t k = 0; k < names.size(); ++k)
+      CHECK_MESSAGE(read_all(dir / names[k]) == before[k], names[k]);
+  };
+  // --html onto the user's note in the folder: refused before the last run's files are cleared.
+  CHECK_THROWS_WITH_AS(run(dir / "notes.txt"),
+                       ((dir / "notes.txt").string() +
+                        " exists and is not a clothlab viewer page; choose another --html, or add "
+                        "--force to replace it")
+                           .c_str(),
+                       OutputError);
+  unchanged();
+
+  // A file of the user's named frames: refused, with or without meshes, and kept; the folder of
+  // mesh frames a run makes is no such file.
+  write_text(dir / "frames", "my notes on these frames\n");
+  const std::string why = (dir / "frames").string() +
+                          " is a file, not the folder of mesh frames (frames/frame_NNNN.obj) "
+                          "that a run keeps there, and a run into " +
+                          dir.string() +
+                          " would remove it; move or rename it, or choose another "
+                          "--out";
+  for (const bool obj : {false, true}) {
+    CHECK_THROWS_WITH_AS(run({}, obj), why.c_str(), OutputError);
+  }
+  CHECK_THROWS_WITH_AS(clothlab::RunFolder(dir, true), why.c_str(), OutputError);
+  CHECK(read_all(dir / "frames") == "my notes on these frames\n");
+  fs::remove(dir / "frames");
+  unchanged();
+  CHECK(run({}, true).frames == 21);
+  CHECK(fs::is_regular_file(dir / "frames" / "frame_0021.obj"));
+  CHECK(run({}).frames == 21);  // the frames of the last run cleared
+  CHECK_FALSE(fs::exists(dir / "frames"));
+
+  // --force into a folder of the user's with such a file: refused too, and no marker made.
+  const fs::path mine = test::scratch_path("refused-unchanged-mine");
+  fs::create_directories(mine);
+  write_text(mine / "frames", "mine\n");
+  CHECK_THROWS_WITH_AS(clothlab::RunFolder(mine, true), doctest::Contains("is a file, not the"),
+                       OutputError);
+  CHECK(names_in(mine) == std::vector<std::string>{"frames"});
+  CHECK(read_all(mine / "frames") == "mine\n");
+}
+
+namespace {
+
+// The run of kCloth (with velocities and springs, or as .npy) in `dir`, whose files repair is
+// then asked to mend.
+void run_for_repair(const fs::path& dir, bool npy) {
+  std::string text = kCloth;
+  text += npy ? "velocities = true\nformat = \"npy\"\n" : "velocities = true\nsprings = true\n";
+  clothlab::Scene scene = clothlab::parse_scene(text, "<cloth>");
+  clothlab::RunOutputs outputs = clothlab::RunOutputs::in(dir);
+  outputs.html.clear();
+  clothlab::run_scene(scene, outputs);
+}
+
+// The first `frames` frames of the CSV text `csv`: its header and their rows.
+std::string first_frames(const std::string& csv, long frames) {
+  size_t at = csv.find('\n') + 1;
+  while (at < csv.size() && std::stol(csv.substr(at, csv.find(',', at) - at)) < frames)
+    at = csv.find('\n', at) + 1;
+  return csv.substr(0, at);
+}
+
+}  // namespace
+
+TEST_CASE("outputs: repair cuts every file to the frames all of them hold whole, and says so") {
+  const fs::path dir = test::scratch_path("repair-short");
+  run_for_repair(dir, false);
+  const std::vector<std::string> names = {"energy.csv", "positions.csv", "springs.csv",
+                                          "velocities.csv"};
+  std::vector<std::string> whole;
+  for (const std::string& name : names)
+    whole.push_back(read_all(dir / name));
+  // A power cut lost the end of velocities.csv: frame 11 holds particles 0 to 4, the 6th row cut
+  // in the middle; then springs.csv, cut at the end of a line: frame 9 holds one spring.
+  std::string velocities = first_frames(whole[3], 11);
+  const std::string frame_11 = whole[3].substr(velocities.size());
+  size_t rows = 0;
+  for (int k = 0; k < 5; ++k)
+    rows = frame_11.find('\n', rows) + 1;
+  write_text(dir / "velocities.csv", velocities + frame_11.substr(0, rows + 10));
+  CHECK(clothlab::cut_to_common_frames(dir) == 11);
+  for (size_t k = 0; k < names.size(); ++k)
+    CHECK_MESSAGE(read_all(dir / names[k]) == first_frames(whole[k], 11), names[k]);
+
+  const size_t first_row = first_frames(whole[2], 9).size();
+  write_text(dir / "springs.csv", whole[2].substr(0, whole[2].find('\n', first_row) + 1));
+  CHECK(clothlab::cut_to_common_frames(dir) == 9);
+  for (size_t k = 0; k < names.size(); ++k)
+    CHECK_MESSAGE(read_all(dir / names[k]) == first_frames(whole[k], 9), names[k]);
+  CHECK(clothlab::cut_to_common_frames(dir) == 9);  // a second time: nothing to do
+
+  // positions.npy cut short, its header still counting every frame: the header is put right.
+  run_for_repair(dir, true);
+  const std::string positions = read_all(dir / "positions.npy");
+  const long frame_bytes = 400 * 3 * 4;
+  write_text(dir / "positions.npy", positions.substr(0, 128 + 15 * frame_bytes + 100));
+  CHECK(clothlab::cut_to_common_frames(dir) == 15);
+  for (const std::string name : {"positions.npy", "velocities.npy"}) {
+    const std::string npy = read_all(dir / name);
+    CHECK_MESSAGE(npy.size() == 128 + 15 * frame_bytes, name);
+    CHECK_MESSAGE(npy.find("'shape': (15, 400, 3)") != std::string::npos, name);
+  }
+  const std::string energy = read_all(dir / "energy.csv");
+  CHECK(std::count(energy.begin(), energy.end(), '\n') == 1 + 15);
+}
+
+TEST_CASE(
+    "outputs: repair refuses a folder of the user's and a file it cannot read, cutting none") {
+  const fs::path dir = test::scratch_path("repair-refused");
+  // The user's own data: no marker.
+  fs::create_directories(dir / "mine");
+  write_text(dir / "mine" / "energy.csv", "frame,t\n0,0\n1,0.1\n");
+  write_text(dir / "mine" / "positions.csv",
+             "frame,t,particle,x,y,z\n0,0,0,1,2,3\n1,0.1,0,1,2,3\n"
+             "2,0.2,0,1,2,3\n");
+  CHECK_THROWS_WITH_AS(clothlab::cut_to_common_frames(dir / "mine"),
+                       ((dir / "mine").string() +
+                        " is not a clothlab output folder: it holds no .clothlab-run marker, and "
+                        "repair cuts the files there; nothing was cut")
+                           .c_str(),
+                       OutputError);
+  CHECK(read_all(dir / "mine" / "positions.csv") ==
+        "frame,t,particle,x,y,z\n0,0,0,1,2,3\n1,0.1,0,1,2,3\n2,0.2,0,1,2,3\n");
+
+  // A run's folder in which a file is not one clothlab wrote: every file as it was.
+  const fs::path run = dir / "run";
+  const std::vector<std::string> names = {"energy.csv", "positions.csv", "springs.csv",
+                                          "velocities.csv"};
+  const auto check_refused = [&](const std::string& name, const std::string& text,
+                                 const std::string& why) {
+    CAPTURE(name);
+    run_for_repair(run, false);
+    write_text(run / name, text);
+    std::vector<std::string> before;
+    for (const std::string& file : names)
+      before.push_back(read_all(run / file));
+    CHECK_THROWS_WITH_AS(
+        clothlab::cut_to_common_frames(run),
+        ((run / name).string() + " is not a file of frames as clothlab writes it: " + why +
+         "; repair cut nothing")
+            .c_str(),
+        OutputError);
+    for (size_t k = 0; k < names.size(); ++k)
+      CHECK_MESSAGE(read_all(run / names[k]) == before[k], names[k]);
+  };
+  check_refused("energy.csv", "garbage\n",
+                "its first line is not the header \"frame,t,kinetic,potential,total,px,py,pz\"");
+  check_refused("energy.csv", "frame,t,kinetic,potential,total,px,py,pz\n0,0,0,0,0,0,0,0\n2,0\n",
+                "line 3 is a row of frame 2 after frame 0");
+  check_refused("positions.csv", "frame,t,particle,x,y,z\n0,0,0,1,2,3\nx,0,1,1,2,3\n",
+                "line 3 is not a row of a frame");
+  check_refused("velocities.csv", "", "it holds no whole header line");
+
+  // .npy files of different particles, or a header that is not clothlab's.
+  run_for_repair(run, true);
+  std::string npy = read_all(run / "velocities.npy");
+  const std::string shape = "'shape': (21, 400, 3)";
+  npy.replace(npy.find(shape), shape.size(), "'shape': (21, 300, 3)");
+  write_text(run / "velocities.npy", npy);
+  const std::string positions = read_all(run / "positions.npy");
+  CHECK_THROWS_WITH_AS(clothlab::cut_to_common_frames(run),
+                       ((run / "positions.npy").string() + " holds frames of 400 particles and " +
+                        (run / "velocities.npy").string() +
+                        " of 300: they are not one run's files; repair cut nothing")
+                           .c_str(),
+                       OutputError);
+  CHECK(read_all(run / "positions.npy") == positions);
+  CHECK(read_all(run / "velocities.npy") == npy);
+  write_text(run / "velocities.npy", "not numpy\n");
+  CHECK_THROWS_WITH_AS(clothlab::cut_to_common_frames(run),
+                       doctest::Contains("velocities.npy is not a file of frames as clothlab "
+                                         "writes it: it is shorter than its header"),
+                       OutputError);
+
+  // Nor while a run writes there.
+  const clothlab::RunFolder busy(run, false);
+  CHECK_THROWS_WITH_AS(clothlab::cut_to_common_frames(run),
+                       doctest::Contains(("is writing into " + run.string() + " now").c_str()),
+                       OutputError);
+}
