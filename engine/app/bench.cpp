@@ -14,13 +14,18 @@
 // log-log plot by a small matplotlib script written next to the CSV.
 #include "app/bench.hpp"
 
+#include <fcntl.h>
+#include <unistd.h>
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <functional>
+#include <limits>
 #include <map>
+#include <new>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -29,6 +34,7 @@
 
 #include "analysis/accuracy.hpp"
 #include "app/build_info.hpp"
+#include "app/grade/text.hpp"
 #include "app/process.hpp"
 #include "clothlab/core/threads.hpp"
 #include "clothlab/core/world.hpp"
@@ -47,6 +53,11 @@ extern const std::string_view kPlotScript;
 namespace {
 
 namespace fs = std::filesystem;
+
+// bench boundary's most particles: as many as bench speed's largest cloth (--sizes 2048), about
+// 1.2 GB for its three worlds. A count past what the machine holds would otherwise allocate
+// until the system refuses, after a long while and with no figure to show for it.
+constexpr Index kMaxBoundaryParticles = Index{2048} * 2048;
 
 World make_world(Index n) {
   World world;
@@ -140,6 +151,7 @@ struct AccuracyOptions {
   std::string out = "clothlab-out/accuracy";
   std::string plot;  // empty: OUT/work-precision.svg
   bool no_plot = false;
+  bool force = false;  // replace files of the bench's names that it did not write
   std::vector<std::string> integrators;
   double time = 0.0;  // [s]; 0: the problem's default
   double zeta = 0.05;
@@ -170,7 +182,17 @@ void print_cheapest(const std::vector<AccuracyRun>& runs) {
   }
 }
 
+constexpr std::string_view kAccuracyCsv = "accuracy.csv";
+constexpr std::string_view kAccuracyHeader =
+    "problem,integrator,dt,steps,error,wall_s_per_sim_s,force_evals_per_sim_s,stable";
+
 int bench_accuracy(const AccuracyOptions& opt) {
+  // Where the results go, before the study's minutes are spent.
+  const fs::path out_dir = opt.out;
+  const fs::path plot = opt.plot.empty() ? out_dir / "work-precision.svg" : fs::path(opt.plot);
+  check_bench_folder(out_dir, std::string(kAccuracyCsv), kAccuracyHeader, opt.force);
+  if (!opt.no_plot) check_bench_plot(plot, std::string(kAccuracyCsv), kAccuracyHeader, opt.force);
+
   std::vector<std::string> integrators = opt.integrators;
   if (integrators.empty()) integrators.assign(integrator_names().begin(), integrator_names().end());
 
@@ -185,11 +207,19 @@ int bench_accuracy(const AccuracyOptions& opt) {
       dts.push_back(0.2 / std::pow(2.0, k));
   } else {
     const Scene scene = load_scene_file(opt.scene);
-    const double end = opt.time > 0.0 ? opt.time : std::min(scene.duration, 0.5);
     // From 8 times the scene's dt down to a quarter of it; the reference at dt / 32.
     const int rungs = opt.quick ? 3 : 6;
     for (int k = 0; k < rungs; ++k)
       dts.push_back(scene.dt * 8.0 / std::pow(2.0, k));
+    // Without --time: as many whole steps of the longest dt as fit in min(duration, 0.5 s), at
+    // least one. min(duration, 0.5 s) itself is rarely a whole number of them (0.5 s is 62.5
+    // steps of lesson 02's 8 x 0.001 s), and the check below would blame a --time the user
+    // never gave.
+    const double longest = dts.front();
+    const double end =
+        opt.time > 0.0
+            ? opt.time
+            : longest * std::max(1.0, std::floor(std::min(scene.duration, 0.5) / longest + 1e-9));
     fmt::print("bench accuracy: running the RK4 reference of {} ...\n", opt.scene);
     problem = std::make_unique<SceneProblem>(opt.scene, end, scene.dt / 32.0);
   }
@@ -227,11 +257,9 @@ int bench_accuracy(const AccuracyOptions& opt) {
   print_cheapest(runs);
 
   // The CSV, then the plot drawn from it.
-  const fs::path out_dir = opt.out;
   fs::create_directories(out_dir);
-  const fs::path csv = out_dir / "accuracy.csv";
-  std::string table =
-      "problem,integrator,dt,steps,error,wall_s_per_sim_s,force_evals_per_sim_s,stable\n";
+  const fs::path csv = out_dir / kAccuracyCsv;
+  std::string table = std::string(kAccuracyHeader) + "\n";
   for (const AccuracyRun& run : runs) {
     fmt::format_to(std::back_inserter(table), "{},{},{:.17g},{},{:.17g},{:.17g},{:.17g},{}\n",
                    problem->name(), run.integrator, run.dt, run.steps, run.error, run.wall_per_sim,
@@ -242,7 +270,7 @@ int bench_accuracy(const AccuracyOptions& opt) {
   write_whole_file(script, kPlotScript);
   fmt::print("\n  wrote {} and {}\n", csv.string(), script.string());
   if (opt.no_plot) return 0;
-  draw_plot(script, csv, opt.plot.empty() ? out_dir / "work-precision.svg" : fs::path(opt.plot));
+  draw_plot(script, csv, plot);
   return 0;
 }
 
@@ -258,7 +286,105 @@ int run_python(const fs::path& script, const fs::path& csv, const fs::path& out)
   return run.timed_out || run.signal != 0 ? 1 : run.exit_code;
 }
 
+// Whether `file` starts with the line `line`; read without following a symbolic link.
+bool first_line_is(const fs::path& file, std::string_view line) {
+  const int fd = ::open(file.c_str(), O_RDONLY | O_NOFOLLOW | O_NONBLOCK | O_CLOEXEC);
+  if (fd < 0) return false;
+  std::string head(line.size() + 1, '\0');
+  size_t got = 0;
+  while (got < head.size()) {
+    const ssize_t n = ::read(fd, head.data() + got, head.size() - got);
+    if (n <= 0) break;
+    got += static_cast<size_t>(n);
+  }
+  ::close(fd);
+  return got == head.size() && head.substr(0, line.size()) == line && head.back() == '\n';
+}
+
+// Throws unless `path`, found and not a symbolic link, is a regular file.
+void require_regular(const fs::path& path, const fs::file_status& status) {
+  if (!fs::is_regular_file(status)) {
+    throw OutputError(fmt::format("cannot write {}: it is {}", path.string(),
+                                  fs::is_directory(status) ? "a folder" : "not a regular file"));
+  }
+}
+
 }  // namespace
+
+void check_bench_file(const fs::path& file, std::string_view option, std::string_view header,
+                      bool force) {
+  std::error_code ec;
+  const fs::file_status status = fs::symlink_status(file, ec);
+  if (!fs::exists(status)) return;
+  if (fs::is_symlink(status)) {
+    // The CSV is made new under the link's name (io/files.hpp): the link goes, its file stays.
+    if (force) return;
+    throw OutputError(fmt::format(
+        "{} is a symbolic link; choose another {}, or add --force to replace the link (the file "
+        "it points to is left alone)",
+        file.string(), option));
+  }
+  require_regular(file, status);
+  if (force || first_line_is(file, header)) return;
+  throw OutputError(
+      fmt::format("{} exists and is not a CSV file this bench wrote (its first line is not the "
+                  "bench's header); choose another {}, or add --force to replace it",
+                  file.string(), option));
+}
+
+void check_bench_folder(const fs::path& dir, const std::string& csv, std::string_view header,
+                        bool force) {
+  std::error_code ec;
+  const fs::file_status status = fs::symlink_status(dir, ec);
+  if (!fs::exists(status)) return;
+  if (fs::is_symlink(status) && !force) {
+    throw OutputError(
+        fmt::format("--out {} is a symbolic link; choose another --out, or add --force to write "
+                    "into the folder it points to",
+                    dir.string()));
+  }
+  if (!fs::is_directory(fs::status(dir, ec))) {
+    throw OutputError(fmt::format("cannot write into --out {}: it is not a folder", dir.string()));
+  }
+  if (force || fs::is_empty(dir, ec)) return;
+  // A folder an earlier bench wrote holds its CSV; the user's folder, with a CSV of that name or
+  // not, is not taken for one.
+  const fs::path own = dir / csv;
+  if (fs::is_regular_file(fs::symlink_status(own, ec)) && first_line_is(own, header)) return;
+  throw OutputError(fmt::format(
+      "--out {} is a folder this bench did not write (it holds no {} of the bench's); choose "
+      "another --out (a new or empty folder), or add --force to write the bench's files there, "
+      "replacing those of the same names",
+      dir.string(), csv));
+}
+
+void check_bench_plot(const fs::path& plot, const std::string& csv, std::string_view header,
+                      bool force) {
+  std::error_code ec;
+  const fs::file_status status = fs::symlink_status(plot, ec);
+  if (!fs::exists(status)) return;
+  if (fs::is_symlink(status)) {
+    if (force) return;
+    throw OutputError(fmt::format(
+        "--plot {} is a symbolic link; choose another --plot, or add --force to draw the plot "
+        "through it",
+        plot.string()));
+  }
+  require_regular(plot, status);
+  if (force) return;
+  const fs::path own = holding_folder(plot) / csv;
+  if (fs::is_regular_file(fs::symlink_status(own, ec)) && first_line_is(own, header)) return;
+  throw OutputError(
+      fmt::format("--plot {} exists and is not a plot this bench drew (one lies beside the "
+                  "bench's {}); choose another --plot, or add --force to replace it",
+                  plot.string(), csv));
+}
+
+void add_bench_force_option(CLI::App& command, bool& force) {
+  command.add_flag("--force", force,
+                   "Replace files of the names the bench writes though it did not write them, and "
+                   "write into a folder it did not make");
+}
 
 double wake_ns(int threads, int meetings, int wakes) {
   using Clock = std::chrono::steady_clock;
@@ -293,10 +419,19 @@ void run_bench_command(std::string_view name, const std::function<int()>& body) 
   try {
     status = body();
   } catch (const SceneError& e) {
-    fmt::print(stderr, "error: {}\n", e.what());
+    std::fflush(stdout);
+    fmt::print(stderr, "error: {}\n", grading::one_line(e.what()));
     status = 2;  // a bad scene, as for `clothlab run`
+  } catch (const std::bad_alloc&) {
+    std::fflush(stdout);
+    fmt::print(stderr,
+               "error: bench {}: not enough memory for the sizes asked for; expected fewer "
+               "particles or smaller cloths\n",
+               name);
+    status = 1;
   } catch (const std::exception& e) {
-    fmt::print(stderr, "error: bench {}: {}\n", name, e.what());
+    std::fflush(stdout);
+    fmt::print(stderr, "error: bench {}: {}\n", name, grading::one_line(e.what()));
     status = 1;
   }
   if (status != 0) throw CLI::RuntimeError(status);
@@ -310,11 +445,19 @@ void add_bench_command(CLI::App& app) {
   static Index n = 10000;
   static long steps = 2000;
   static int repeats = 5;
-  boundary->add_option("--particles", n, "Particles")->check(CLI::PositiveNumber);
-  boundary->add_option("--steps", steps, "Steps per repeat")->check(CLI::PositiveNumber);
+  boundary->add_option("--particles", n, "Particles")
+      ->check(CLI::Range(Index{1}, kMaxBoundaryParticles))
+      ->capture_default_str();
+  boundary->add_option("--steps", steps, "Steps per repeat")
+      ->check(CLI::Range(1L, std::numeric_limits<long>::max()));
   boundary->add_option("--repeats", repeats, "Repeats (median is shown)")
-      ->check(CLI::PositiveNumber);
-  boundary->callback([] { bench_boundary(n, steps, repeats); });
+      ->check(CLI::Range(1, std::numeric_limits<int>::max()));
+  boundary->callback([] {
+    run_bench_command("boundary", [] {
+      bench_boundary(n, steps, repeats);
+      return 0;
+    });
+  });
 
   add_bench_speed_command(*bench);
 
@@ -333,14 +476,15 @@ void add_bench_command(CLI::App& app) {
   accuracy->add_option("--plot", a.plot,
                        "Plot file (.svg, .png or .pdf; default OUT/work-precision.svg)");
   accuracy->add_flag("--no-plot", a.no_plot, "Write the CSV and the script, draw nothing");
+  add_bench_force_option(*accuracy, a.force);
   accuracy->add_option("--integrators", a.integrators, "Integrators to compare (default: all)")
       ->delimiter(',')
       ->check(CLI::IsMember(
           std::vector<std::string>(integrator_names().begin(), integrator_names().end())));
   accuracy
       ->add_option("--time", a.time,
-                   "End time [s] (default 4 s for the oscillator, min(duration, 0.5 s) for "
-                   "a scene)")
+                   "End time [s] (default 4 s for the oscillator; for a scene, min(duration, "
+                   "0.5 s) cut to whole steps of the longest time step, 8 x dt)")
       ->check(CLI::PositiveNumber);
   accuracy->add_option("--zeta", a.zeta, "The oscillator's damping ratio (0 <= zeta < 1)")
       ->check(CLI::Range(0.0, 0.999))

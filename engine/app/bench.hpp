@@ -38,7 +38,27 @@ double wake_ns(int threads, int meetings = 0, int wakes = 20000);
 void draw_plot(const std::filesystem::path& script, const std::filesystem::path& csv,
                const std::filesystem::path& plot);
 
+// Where a bench command writes, checked before it measures anything, so that it never replaces a
+// user's file by surprise (as `clothlab run` never writes into a user's folder without --force).
+// Each throws OutputError naming the path and saying what to do, unless `force`:
+//   check_bench_file    `file`, given as `option` ("--csv"), must be absent or a regular file
+//                       whose first line is `header`, the bench's own CSV header;
+//   check_bench_folder  `dir`, given as --out, must not be a symbolic link, and be absent, empty,
+//                       or a folder a bench wrote: one holding `csv` (checked as above);
+//   check_bench_plot    `plot` must be absent, or a regular file beside the bench's own `csv`
+//                       (a plot has nothing of its own to tell it from a user's).
+// A folder, device or other file that is not a regular one is refused even with `force`.
+void check_bench_file(const std::filesystem::path& file, std::string_view option,
+                      std::string_view header, bool force);
+void check_bench_folder(const std::filesystem::path& dir, const std::string& csv,
+                        std::string_view header, bool force);
+void check_bench_plot(const std::filesystem::path& plot, const std::string& csv,
+                      std::string_view header, bool force);
+// The option `--force` of the bench commands that write files.
+void add_bench_force_option(CLI::App& command, bool& force);
+
 // Runs a bench command's body: a bad scene is reported as `clothlab run` reports it (exit 2),
-// another error as "error: bench NAME: ..." (exit 1).
+// another error as "error: bench NAME: ..." (exit 1), running out of memory as well (with a
+// word on what to ask for instead).
 void run_bench_command(std::string_view name, const std::function<int()>& body);
 }  // namespace clothlab::app

@@ -79,6 +79,7 @@ struct MethodsOptions {
   std::string out = "clothlab-out/methods";
   std::string plot;  // empty: OUT/methods.svg
   bool no_plot = false;
+  bool force = false;  // replace files of the bench's names that it did not write
   bool quick = false;
   double min_seconds = 0.05;  // wall time each run is repeated for
   bool speed = false;
@@ -812,7 +813,18 @@ void speed(const MethodsOptions& opt, const fs::path& out_dir) {
   fmt::print("  wrote {}\n", (out_dir / "speed.csv").string());
 }
 
+constexpr std::string_view kMethodsCsv = "methods.csv";
+constexpr std::string_view kMethodsHeader =
+    "scene,method,dt,substeps,iterations,steps,error,worst_strain,energy_lost,wall_s_per_sim_s,"
+    "stable";
+
 int bench_methods(const MethodsOptions& opt) {
+  // Where the results go, before the bake-off's minutes are spent.
+  const fs::path out_dir = opt.out;
+  const fs::path plot = opt.plot.empty() ? out_dir / "methods.svg" : fs::path(opt.plot);
+  check_bench_folder(out_dir, std::string(kMethodsCsv), kMethodsHeader, opt.force);
+  if (!opt.no_plot) check_bench_plot(plot, std::string(kMethodsCsv), kMethodsHeader, opt.force);
+
   std::vector<std::string> scenes = opt.scenes;
   if (scenes.empty()) {
     const fs::path lesson = fs::path(CLOTHLAB_SOURCE_DIR) / "lessons" / "12-xpbd";
@@ -840,12 +852,9 @@ int bench_methods(const MethodsOptions& opt) {
     runs.insert(runs.end(), more.begin(), more.end());
   }
 
-  const fs::path out_dir = opt.out;
   fs::create_directories(out_dir);
-  const fs::path csv = out_dir / "methods.csv";
-  std::string table =
-      "scene,method,dt,substeps,iterations,steps,error,worst_strain,energy_lost,"
-      "wall_s_per_sim_s,stable\n";
+  const fs::path csv = out_dir / kMethodsCsv;
+  std::string table = std::string(kMethodsHeader) + "\n";
   for (const MethodRun& r : runs) {
     fmt::format_to(std::back_inserter(table),
                    "{},{},{:.17g},{},{},{},{:.17g},{:.17g},{:.17g},"
@@ -860,7 +869,7 @@ int bench_methods(const MethodsOptions& opt) {
   fmt::print("\n  wrote {} and {}\n", csv.string(), script.string());
   if (opt.speed) speed(opt, out_dir);
   if (opt.no_plot) return 0;
-  draw_plot(script, csv, opt.plot.empty() ? out_dir / "methods.svg" : fs::path(opt.plot));
+  draw_plot(script, csv, plot);
   return 0;
 }
 
@@ -881,6 +890,7 @@ void add_bench_methods_command(CLI::App& bench) {
   methods->add_option("--plot", options.plot,
                       "Plot file (.svg, .png or .pdf; default OUT/methods.svg)");
   methods->add_flag("--no-plot", options.no_plot, "Write the CSV and the script, draw nothing");
+  add_bench_force_option(*methods, options.force);
   methods->add_flag("--quick", options.quick, "Shorter ladders and a cheaper reference (tests)");
   methods->add_flag("--large", options.large,
                     "Lesson 12's cloths of real size (48 x 48 particles, a woven fabric's "

@@ -79,6 +79,7 @@ struct RooflineOptions {
   double stream_mib = 0.0;    // [MiB] each array of the memory figures; 0: 4 x the last level
   double socket_gbs = 100.0;  // [GB/s] the model's server socket: an assumption, not measured
   std::string csv;
+  bool force = false;  // --csv may replace a file the bench did not write
   bool quick = false;
 };
 
@@ -471,7 +472,15 @@ std::string load_average() {
   return getloadavg(load, 1) == 1 ? fmt::format("{:.2f}", load[0]) : "unknown";
 }
 
+constexpr std::string_view kRooflineHeader =
+    "n,particles,springs,data_bytes,bytes_per_spring,copy_gb_per_s,compute_floor_ns,"
+    "bandwidth_floor_ns,floor_ns,engine_ns,engine_over_floor,engine_1_thread_ns,"
+    "engine_2_threads_ns,speedup_2,lost_serial,lost_energy_check,lost_wake,lost_imbalance,"
+    "lost_work,model_2_ns,model_8_ns,model_16_ns,kernel_ns,engine_over_kernel";
+
 int bench_roofline(RooflineOptions opt) {
+  // Where the CSV goes, before the measurements' minutes are spent.
+  if (!opt.csv.empty()) check_bench_file(opt.csv, "--csv", kRooflineHeader, opt.force);
   if (opt.quick) {
     opt.sizes = {16, 32};
     opt.repeats = 3;
@@ -649,11 +658,7 @@ int bench_roofline(RooflineOptions opt) {
   if (!opt.csv.empty()) {
     const std::filesystem::path csv = opt.csv;
     if (csv.has_parent_path()) std::filesystem::create_directories(csv.parent_path());
-    std::string table =
-        "n,particles,springs,data_bytes,bytes_per_spring,copy_gb_per_s,compute_floor_ns,"
-        "bandwidth_floor_ns,floor_ns,engine_ns,engine_over_floor,engine_1_thread_ns,"
-        "engine_2_threads_ns,speedup_2,lost_serial,lost_energy_check,lost_wake,lost_imbalance,"
-        "lost_work,model_2_ns,model_8_ns,model_16_ns,kernel_ns,engine_over_kernel\n";
+    std::string table = std::string(kRooflineHeader) + "\n";
     for (size_t k = 0; k < rows.size(); ++k) {
       const Row& r = rows[k];
       const ThreadsRow& t = threads[k];
@@ -708,6 +713,7 @@ void add_bench_roofline_command(CLI::App& bench) {
       ->check(CLI::PositiveNumber)
       ->capture_default_str();
   roofline->add_option("--csv", o.csv, "Write one row per cloth size to this CSV file");
+  add_bench_force_option(*roofline, o.force);
   roofline->add_flag("--quick", o.quick,
                      "Sizes 16 and 32, short repeats, 16 MiB arrays (for tests)");
   roofline->callback([] { run_bench_command("roofline", [] { return bench_roofline(options); }); });

@@ -82,6 +82,7 @@ struct SpeedOptions {
   double min_seconds = 0.25;  // [s] wall time of one repeat
   int threads = 0;            // "all cores": 0 asks the machine
   std::string csv;
+  bool force = false;                 // --csv may replace a file the bench did not write
   std::vector<std::string> variants;  // empty: every variant
   bool quick = false;
   bool no_student = false;
@@ -699,7 +700,12 @@ void print_table(const std::vector<Measurement>& rows) {
   }
 }
 
+constexpr std::string_view kSpeedHeader =
+    "variant,n,threads,springs,ns_per_spring_step,steps_per_s,particles";
+
 int bench_speed(SpeedOptions opt) {
+  // Where the CSV goes, before the measurements' minutes are spent.
+  if (!opt.csv.empty()) check_bench_file(opt.csv, "--csv", kSpeedHeader, opt.force);
   if (opt.single) {
     opt.variants = {"reference", "bare", "float"};
   }
@@ -742,7 +748,7 @@ int bench_speed(SpeedOptions opt) {
   if (!opt.csv.empty()) {
     const fs::path csv = opt.csv;
     if (csv.has_parent_path()) fs::create_directories(csv.parent_path());
-    std::string table = "variant,n,threads,springs,ns_per_spring_step,steps_per_s,particles\n";
+    std::string table = std::string(kSpeedHeader) + "\n";
     for (const Measurement& m : rows) {
       fmt::format_to(std::back_inserter(table), "{},{},{},{},{:.6g},{:.6g},{}\n", m.variant, m.n,
                      m.threads, m.springs, m.ns_per_spring_step, m.steps_per_s, m.n * m.n);
@@ -806,6 +812,7 @@ void add_bench_speed_command(CLI::App& bench) {
   speed->add_option("--threads", o.threads, "Threads of the all-cores rows (default: every core)")
       ->check(CLI::Range(1, 1024));
   speed->add_option("--csv", o.csv, "Write one row per measurement to this CSV file");
+  add_bench_force_option(*speed, o.force);
   // A misspelt variant is an error, not an empty table.
   CLI::Option* variants =
       speed->add_option("--variants", o.variants, "Variants to measure (default: all)")

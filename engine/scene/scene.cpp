@@ -23,13 +23,28 @@
 
 namespace clothlab {
 
+namespace {
+
+// `text` with each NUL character written "^@", as a message shows every other control character
+// (caret notation): what() hands the message on as a C string, which would end at the first NUL
+// that a scene's string, key or table name carries ("\u0000"), and lose the rest of it.
+std::string without_nul(const std::string& text) {
+  std::string out;
+  out.reserve(text.size());
+  for (char c : text)
+    out += c == '\0' ? std::string_view("^@") : std::string_view(&c, 1);
+  return out;
+}
+
+}  // namespace
+
 SceneError::SceneError(const std::string& source, long line, long column,
                        const std::string& message)
-    : std::runtime_error(fmt::format("{}:{}:{}: {}", source, line, column, message)),
+    : std::runtime_error(without_nul(fmt::format("{}:{}:{}: {}", source, line, column, message))),
       source_(source),
       line_(line),
       column_(column),
-      message_(message) {}
+      message_(without_nul(message)) {}
 
 std::string SceneWarning::text() const {
   return fmt::format("{}:{}:{}: {}", source, line, column, message);
@@ -172,6 +187,7 @@ void SceneTable::record_tunables(std::string_view keys, std::string path, bool d
   path_ = std::move(path);
   record_defaults_ = defaults;
   tunables_ = &out;
+  tunables_from_ = out.size();
 }
 
 void SceneTable::record(std::string_view key, std::optional<size_t> element, double value,
@@ -182,7 +198,11 @@ void SceneTable::record(std::string_view key, std::optional<size_t> element, dou
   if (element) path += fmt::format("[{}]", *element);
   TunableNumber number{
       path, value, range.min, range.max, range.min_exclusive, std::string(range.unit), in_text};
-  for (TunableNumber& known : *tunables_) {
+  // Only this table's own numbers can share its path: looking among them alone, and not through
+  // every table read before, keeps a scene of many [[spring]] tables from taking time quadratic
+  // in their number.
+  for (size_t k = tunables_from_; k < tunables_->size(); ++k) {
+    TunableNumber& known = (*tunables_)[k];
     if (known.path == number.path) {  // read twice: the last reading holds
       known = number;
       return;

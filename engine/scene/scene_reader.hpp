@@ -94,6 +94,7 @@ class SceneTable {
   std::string path_;
   bool record_defaults_ = false;
   std::vector<TunableNumber>* tunables_ = nullptr;
+  size_t tunables_from_ = 0;  // the first of `tunables_` this table recorded
 };
 
 // The name in `candidates` (separated by spaces) nearest to `typo`, or "" if none is close.

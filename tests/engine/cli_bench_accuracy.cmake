@@ -27,3 +27,19 @@ list(LENGTH lines count)
 if(NOT count EQUAL 7)  # 2 integrators x 3 time steps, and the header
   message(FATAL_ERROR "the scene's accuracy.csv has ${count} lines; expected 7\n${out}")
 endif()
+
+# Without --time, the scene's default end time is one its ladder takes: lesson 02's spring
+# (dt = 0.001 s, a longest step of 8 dt = 0.008 s) was refused with "--time 0.5 s is not a whole
+# number of steps of 0.008 s", a --time the user never gave. A --time the user gives is still
+# checked.
+run_bench("bench accuracy on ${SCENE} without --time" bench accuracy ${SCENE} --quick --no-plot
+          --min-seconds 0.001 --integrators symplectic-euler --out default-time)
+if(NOT out MATCHES "symplectic-euler +0\\.008 +62 ")  # 62 steps of 0.008 s: 0.496 s, within 0.5 s
+  message(FATAL_ERROR "no run of 62 steps of 0.008 s to 0.496 s:\n${out}")
+endif()
+execute_process(COMMAND ${CLOTHLAB} bench accuracy ${SCENE} --quick --no-plot --time 0.5
+                        --min-seconds 0.001 --integrators symplectic-euler --out given-time
+                WORKING_DIRECTORY ${WORK} RESULT_VARIABLE code ERROR_VARIABLE err OUTPUT_QUIET)
+if(NOT code EQUAL 1 OR NOT err MATCHES "--time 0\\.5 s is not a whole number of steps of 0\\.008 s")
+  message(FATAL_ERROR "--time 0.5 on a scene of dt = 0.001 s: exit ${code}\n${err}")
+endif()

@@ -56,6 +56,11 @@ endforeach()
 file(WRITE ${WORK}/table.toml "[\"x\\u001b]0;title\\u0007\"]\n")
 run_clothlab("validate, a table's name" 2 validate ${WORK}/table.toml)
 expect_text("validate, a table's name" "${err}" "unknown table [x^[]0;title^G]")
+# A NUL among them, shown as ^@: it once ended the message there, and what was expected was lost.
+file(WRITE ${WORK}/nul.toml "[\"x\\u0000y\\u001b\"]\n")
+run_clothlab("validate, a table's name with a NUL" 2 validate ${WORK}/nul.toml)
+expect_text("validate, a table's name with a NUL" "${err}"
+            "unknown table [x^@y^[]; expected one of: ")
 
 # The scene's path in validate's report.
 set(named "${WORK}/scene${bell}.toml")

@@ -586,6 +586,34 @@ TEST_CASE("scene error: a particle on two long pin paths is found without compar
                        clothlab::SceneError);
 }
 
+TEST_CASE(
+    "scene error: a NUL in a string, a key or a table's name is shown as ^@, the message whole") {
+  // what() hands the message on as a C string: a raw NUL ("\u0000" in TOML) ended it there, and
+  // the rest, what was expected, was lost.
+  const std::string particle = "[[particle]]\nposition = [0, 1, 0]\nmass = 1\n";
+  const std::string integrator = "[integrator]\ndt = 0.01\nduration = 0.1\n";
+  CHECK_THROWS_WITH_AS(
+      (void)clothlab::parse_scene(particle + integrator + "method = \"symplectic-euler\\u0000\"\n",
+                                  "nul.toml"),
+      doctest::Contains("nul.toml:7:10: unknown method 'symplectic-euler^@' in [integrator]; "
+                        "expected one of: "),
+      clothlab::SceneError);
+  CHECK_THROWS_WITH_AS(
+      (void)clothlab::parse_scene(particle + integrator + "\"k\\u0000x\" = 1\n", "nul.toml"),
+      doctest::Contains("'k^@x' in [integrator]; expected "), clothlab::SceneError);
+  CHECK_THROWS_WITH_AS(
+      (void)clothlab::parse_scene(particle + integrator + "[\"t\\u0000x\"]\na = 1\n", "nul.toml"),
+      doctest::Contains("nul.toml:7:2: unknown table [t^@x]; expected one of: "),
+      clothlab::SceneError);
+  try {
+    (void)clothlab::parse_scene(particle + "[\"\\u0000\"]\n" + integrator, "nul.toml");
+    FAIL("a table named NUL loaded");
+  } catch (const clothlab::SceneError& e) {
+    CHECK(e.message().find('\0') == std::string::npos);
+    CHECK(std::string(e.what()).ends_with(e.message()));
+  }
+}
+
 TEST_CASE("scene error: a directory, a device and a huge file are refused before reading") {
   const fs::path dir = test::scratch_path("scene-inputs");
   fs::create_directories(dir);
