@@ -13,8 +13,9 @@
 //
 // All the steps are one job of the world's threads: each thread takes its particles through
 // every step, and waits at a barrier between two steps (the next reads the x and v every thread
-// has just written), where one thread also does the world's part of the step between them (the
-// time, the counts, and each force effect's set_time, before a second barrier).
+// has just written), where one thread also tells each force effect the next step's time
+// (set_time), before a second barrier. The world's time and counts move after the job, by the
+// steps taken.
 #pragma once
 
 #include <atomic>

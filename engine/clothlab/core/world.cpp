@@ -76,7 +76,7 @@ void World::advance(double dt, long count) {
     }
     count -= taken.taken;
     if (!taken.within) guard.check(*this, /*before_step=*/false);  // names the particle, throws
-    if (steps % guard.energy_check_every == 0) guard.check_energy(*this);
+    if (steps % every == 0) guard.check_energy(*this);
   }
 }
 
