@@ -964,6 +964,31 @@ void read_guard(SceneTable& t, Scene& scene) {
       t.number("max_energy_growth", Range::positive(""), guard.max_energy_growth);
 }
 
+// What of `scene` the float room would compute with that a float cannot hold, or "": a number of
+// the scene (ks = 1e39 would be inf, and the first step NaN), a particle's 1/m (the move's) or its
+// start. A step in float of any of them could only blow up.
+std::string beyond_float(const Scene& scene) {
+  constexpr double kFloatMax = std::numeric_limits<float>::max();
+  for (const TunableNumber& number : scene.tunables) {
+    if (std::abs(number.value) > kFloatMax)
+      return fmt::format("{} = {:g}{}{}", number.path, number.value, number.unit.empty() ? "" : " ",
+                         number.unit);
+  }
+  const Particles& p = scene.world.particles;
+  for (Index i = 0; i < p.size(); ++i) {
+    if (p.inv_m[i] > kFloatMax)
+      return fmt::format("particle {}'s mass, {:g} kg, whose inverse is {:g} 1/kg", i, p.m[i],
+                         p.inv_m[i]);
+    if (p.x.col(i).cwiseAbs().maxCoeff() > kFloatMax)
+      return fmt::format("particle {}'s start, {:g} m from the origin along an axis", i,
+                         p.x.col(i).cwiseAbs().maxCoeff());
+    if (p.v.col(i).cwiseAbs().maxCoeff() > kFloatMax)
+      return fmt::format("particle {}'s start velocity, {:g} m/s along an axis", i,
+                         p.v.col(i).cwiseAbs().maxCoeff());
+  }
+  return "";
+}
+
 // [engine]: how the engine runs the scene (the physics does not depend on it).
 void read_engine(SceneTable& t, Scene& scene) {
   World& world = scene.world;
@@ -977,6 +1002,11 @@ void read_engine(SceneTable& t, Scene& scene) {
     if (const std::string why = fast::use_float(world); !why.empty()) {
       t.fail("precision",
              fmt::format("precision = \"float\": {}; expected precision = \"double\"", why));
+    }
+    if (const std::string why = beyond_float(scene); !why.empty()) {
+      t.fail("precision", fmt::format("precision = \"float\": {}, beyond what a float holds "
+                                      "({:g}); expected precision = \"double\"",
+                                      why, std::numeric_limits<float>::max()));
     }
   }
 }

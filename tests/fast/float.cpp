@@ -297,6 +297,21 @@ TEST_CASE("float: a bad precision or a scene float does not cover is an error at
   CHECK(load_error(text).find("float.toml:" + std::to_string(line) + ":") == 0);
   // double (the default) loads with anything.
   CHECK(load_error(cloth("rk4", 0.0005, "", "double")).empty());
+  // A number float cannot hold (it would be inf in the float room, and the first step NaN): named,
+  // at the precision key. In double the same scene loads.
+  std::string stiff = cloth();
+  stiff.replace(stiff.find("ks = 60"), 7, "ks = 1e39");
+  const std::string beyond = load_error(stiff);
+  CAPTURE(beyond);
+  CHECK(beyond.find("float.toml:" + std::to_string(line) + ":") == 0);
+  CHECK(beyond.find("springs.ks = 1e+39") != std::string::npos);
+  CHECK(beyond.find("beyond what a float holds") != std::string::npos);
+  stiff.replace(stiff.find("precision = \"float\""), 19, "precision = \"double\"");
+  CHECK(load_error(stiff).empty());
+  // A particle so light that 1/m is beyond float.
+  std::string light = cloth();
+  light.replace(light.find("mass = 0.5"), 10, "mass = 1e-37");
+  CHECK(load_error(light).find("whose inverse is") != std::string::npos);
 }
 
 TEST_CASE("float: a program that adds an effect the float room does not cover gets an error") {
