@@ -93,6 +93,14 @@ template <class Collider>
   collider.collide(p, begin, end);
 }
 
+// The Euler methods' one-particle kernels, each a type of its own, so that every loop given one
+// is compiled for it, the kernel inlined: the step's pass (euler_move) and a run of steps
+// (FastEngine::steps) call the same two.
+constexpr auto kExplicitEuler = [](const Vec3& r, const Vec3& v, const Vec3& f, double inv_m,
+                                   double h) { return explicit_euler_step(r, v, f, inv_m, h); };
+constexpr auto kSymplecticEuler = [](const Vec3& r, const Vec3& v, const Vec3& f, double inv_m,
+                                     double h) { return symplectic_euler_step(r, v, f, inv_m, h); };
+
 // An Euler method's move of particles [begin, end) (FastEngine::MoveRange), from the copies
 // when it has them. The kernels come wrapped in lambdas, each a type of its own, so that each
 // loop is compiled for its kernel, inlined.
@@ -200,15 +208,7 @@ BackendStep FastEngine::step(World& world, double dt) {
   for (size_t k = contacts_.size(); k < world.post_step_effects.size(); ++k)
     world.post_step_effects[k]->before_step(world);
   const MoveRange move =
-      explicit_euler
-          ? euler_move(p, dt,
-                       [](const Vec3& r, const Vec3& v, const Vec3& f, double inv_m, double h) {
-                         return explicit_euler_step(r, v, f, inv_m, h);
-                       })
-          : euler_move(p, dt,
-                       [](const Vec3& r, const Vec3& v, const Vec3& f, double inv_m, double h) {
-                         return symplectic_euler_step(r, v, f, inv_m, h);
-                       });
+      explicit_euler ? euler_move(p, dt, kExplicitEuler) : euler_move(p, dt, kSymplecticEuler);
   MoveRange move_then_contacts;
   const MoveRange* moves = &move;
   if (!contacts_.empty()) {
@@ -259,14 +259,11 @@ BackendSteps FastEngine::steps(World& world, double dt, long count) {
     };
   };
   const Index block = std::max<Index>(pass_block, 1);
-  if (explicit_euler) {
+  if (explicit_euler)
     return resident_steps(world, dt, count, resident_, block, kPassChunk, add,
-                          moves([](const Vec3& r, const Vec3& v, const Vec3& f, double inv_m,
-                                   double h) { return explicit_euler_step(r, v, f, inv_m, h); }));
-  }
+                          moves(kExplicitEuler));
   return resident_steps(world, dt, count, resident_, block, kPassChunk, add,
-                        moves([](const Vec3& r, const Vec3& v, const Vec3& f, double inv_m,
-                                 double h) { return symplectic_euler_step(r, v, f, inv_m, h); }));
+                        moves(kSymplecticEuler));
 }
 
 void FastEngine::pass(const World& world, const Matrix3X& x, const Matrix3X& v, Matrix3X& f,

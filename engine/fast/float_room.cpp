@@ -175,12 +175,7 @@ std::string use_float(World& world) {
 
 BackendSteps FloatRoom::steps(World& world, double dt, long count) {
   if (count <= 0 || !world.post_step_effects.empty()) return {};
-  const auto& effects = world.force_effects;
-  forces_.resize(effects.size());
-  for (size_t e = 0; e < effects.size(); ++e) {
-    forces_[e].match(*effects[e], fast_force_float);
-    if (!forces_[e].fast) return {};  // step() says what is not covered
-  }
+  if (!match_forces(world)) return {};  // step() says what is not covered
   const bool symplectic = dynamic_cast<const SymplecticEuler*>(world.integrator.get()) != nullptr;
   if (!symplectic && !dynamic_cast<const ExplicitEuler*>(world.integrator.get())) return {};
   const Particles& p = world.particles;
@@ -201,16 +196,20 @@ BackendSteps FloatRoom::steps(World& world, double dt, long count) {
                         });
 }
 
-BackendStep FloatRoom::step(World& world, double dt) {
-  // Each force effect's float form, made again only for an effect not seen at this place. A
-  // world that holds something not covered (added since the scene loaded) stops here.
+bool FloatRoom::match_forces(const World& world) {
   const auto& effects = world.force_effects;
   forces_.resize(effects.size());
-  bool all_covered = covered(world.integrator.get());
+  bool all = true;
   for (size_t e = 0; e < effects.size(); ++e) {
     forces_[e].match(*effects[e], fast_force_float);
-    all_covered = all_covered && forces_[e].fast;
+    all = all && forces_[e].fast;
   }
+  return all;
+}
+
+BackendStep FloatRoom::step(World& world, double dt) {
+  // A world that holds something not covered (added since the scene loaded) stops here.
+  bool all_covered = match_forces(world) && covered(world.integrator.get());
   for (const auto& effect : world.post_step_effects)
     all_covered = all_covered && covered(*effect);
   if (!all_covered) {

@@ -64,6 +64,10 @@ class FloatRoom {
   BackendSteps steps(World& world, double dt, long count);
 
  private:
+  // Each of the world's force effects' float form in forces_, made again only for an effect not
+  // seen at its place; false if one has none.
+  bool match_forces(const World& world);
+
   std::vector<FastForceSlot<float>> forces_;  // the world's force effects, in float
   CopiesOf<float> copies_;
   ResidentOf<float> resident_;  // steps' two copies of the state
