@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <atomic>
 #include <cmath>
+#include <limits>
 #include <stdexcept>
 
 #include "clothlab/after_step/ground_collision.hpp"
@@ -93,28 +94,42 @@ template <bool Symplectic>
   return outside == 0;
 }
 
+// The largest float at most `bound` (a guard's bound, a double): for any float r, r <= bound
+// exactly when r <= float_at_most(bound), NaN and infinities included, so that a float can be
+// tested against a double's bound without being widened to double.
+float float_at_most(double bound) {
+  float f = static_cast<float>(bound);
+  if (static_cast<double>(f) > bound)
+    f = std::nextafter(f, -std::numeric_limits<float>::infinity());
+  return f;
+}
+
 // The same move into the other copy of the state, for a run of steps that keeps it in float
 // (resident.hpp): the new x and v to next's rows (x_out, v_out, strides nxo and nvo), tested as
-// above; the forces stay in the copies.
+// above, but in float, against the bounds rounded down to floats (float_at_most: the same test),
+// and with the count of values outside kept as a flag of the floats' width: widening 16 floats to
+// doubles, and their tests to 64-bit counts, took more instructions than the move itself; for
+// the same reason 1/m comes rounded to float once for the run of steps (inv_m, FloatRoom::inv_m_:
+// the same float as rounded here). The forces stay in the copies.
 template <bool Symplectic>
 [[gnu::noinline]] bool move_in_float_resident(
     Index begin, Index end, float dt, const float* __restrict x, Index nx,
     const float* __restrict v, Index nv, const float* __restrict f, Index nf,
-    const double* __restrict inv_m, float* __restrict x_out, Index nxo, float* __restrict v_out,
+    const float* __restrict inv_m, float* __restrict x_out, Index nxo, float* __restrict v_out,
     Index nvo, double max_position, double max_speed) {
-  long outside = 0;
+  const float max_r = float_at_most(max_position), max_v = float_at_most(max_speed);
+  int outside = 0;
   for (Index i = begin; i < end; ++i) {
     const Vec3f fi(f[i], f[nf + i], f[2 * nf + i]);
     const Vec3f xi(x[i], x[nx + i], x[2 * nx + i]);
     const Vec3f vi(v[i], v[nv + i], v[2 * nv + i]);
-    const float inv_mi = static_cast<float>(inv_m[i]);
-    PointStateOf<float> next = Symplectic ? symplectic_euler(xi, vi, fi, inv_mi, dt)
-                                          : explicit_euler(xi, vi, fi, inv_mi, dt);
+    PointStateOf<float> next = Symplectic ? symplectic_euler(xi, vi, fi, inv_m[i], dt)
+                                          : explicit_euler(xi, vi, fi, inv_m[i], dt);
     for (int c = 0; c < 3; ++c) {
       x_out[c * nxo + i] = next.r[c];
       v_out[c * nvo + i] = next.v[c];
-      const double r = next.r[c], u = next.v[c];
-      outside += !(std::abs(r) <= max_position) + !(std::abs(u) <= max_speed);
+      outside |= static_cast<int>(!(std::abs(next.r[c]) <= max_r)) |
+                 static_cast<int>(!(std::abs(next.v[c]) <= max_v));
     }
   }
   return outside == 0;
@@ -181,6 +196,7 @@ BackendSteps FloatRoom::steps(World& world, double dt, long count) {
   const Particles& p = world.particles;
   for (const FastForceSlot<float>& force : forces_)
     force.fast->prepare(p);
+  inv_m_.assign(p.inv_m.begin(), p.inv_m.end());  // rounded once for the steps (the move's note)
   const auto add = [&](Index b0, Index b1, const SoA3f& x, const SoA3f& v, SoA3f& f) {
     for (const FastForceSlot<float>& force : forces_)
       force.fast->add(p, x, v, f, b0, b1);
@@ -190,7 +206,7 @@ BackendSteps FloatRoom::steps(World& world, double dt, long count) {
   return resident_steps(world, dt, count, resident_, kPassBlock, kPassChunk, add,
                         [&](Index c0, Index c1, const CopiesOf<float>& now, CopiesOf<float>& next) {
                           return move(c0, c1, h, now.x.data(), now.x.cols(), now.v.data(),
-                                      now.v.cols(), now.f.data(), now.f.cols(), p.inv_m.data(),
+                                      now.v.cols(), now.f.data(), now.f.cols(), inv_m_.data(),
                                       next.x.data(), next.x.cols(), next.v.data(), next.v.cols(),
                                       world.guard.max_position, world.guard.max_speed);
                         });

@@ -71,6 +71,7 @@ class FloatRoom {
   std::vector<FastForceSlot<float>> forces_;  // the world's force effects, in float
   CopiesOf<float> copies_;
   ResidentOf<float> resident_;  // steps' two copies of the state
+  std::vector<float> inv_m_;    // and the particles' 1/m, rounded to float
 };
 
 }  // namespace clothlab::fast

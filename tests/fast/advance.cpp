@@ -188,3 +188,69 @@ TEST_CASE("advance: a world with a post-step effect takes its steps one at a tim
   check_same(at_once.scene.world, one.scene.world);
   CHECK(at_once.wakes >= 300);
 }
+
+TEST_CASE("advance: in float, a position one float past the guard's bound stops the step") {
+  // The float room's run of steps tests its new state in float, against the bound rounded down
+  // to a float; the test must be the double one all the same. One particle, no force, moves by
+  // v dt = 2^-13 m/s x 2^-10 s = 2^-23 m a step, exactly, from x = 1 - 2^-23 m: to 1 m after
+  // step 1 (the world's own step: the guard's first), to 1 + 2^-23 m after step 2 (the first of
+  // the run), past a bound of 1.00000007 m. Rounded to the nearest float, that bound would be
+  // 1 + 2^-23 itself, and the step would pass; the next would stop.
+  const std::string text = R"([[particle]]
+position = [0.99999988079071044921875, 0.0, 0.0]
+velocity = [0.0001220703125, 0.0, 0.0]
+mass = 1.0
+[integrator]
+method = "symplectic-euler"
+dt = 0.0009765625
+duration = 1.0
+[guard]
+max_position = 1.00000007
+[engine]
+precision = "float"
+)";
+  for (const bool at_once : {true, false}) {
+    CAPTURE(at_once);
+    clothlab::Scene scene = clothlab::parse_scene(text, "advance.toml");
+    const Stop stop = stop_of(scene.world, scene.dt, 4, at_once);
+    CAPTURE(stop.message);
+    CHECK(stop.step == 2);
+    CHECK(stop.particle == 0);
+    CHECK(scene.world.particles.x(0, 0) == 1.0 + 0x1p-23);  // the state the guard stopped at
+  }
+}
+
+TEST_CASE("advance: in float, the steps read the masses the particles have now") {
+  // The float room rounds the masses and their inverses to float once for a run of steps; a
+  // program that changes them between two runs must see the new ones used: the same bits as
+  // World::step in float, and near the double run (three times the mass under the same gravity:
+  // with the old masses in f = m g the cloth would fall at a third of g, millimetres off).
+  const auto heavier = [](clothlab::World& world) {
+    clothlab::Particles& p = world.particles;
+    for (Index i = 0; i < p.size(); ++i) {
+      if (p.inv_m(i) == 0.0) continue;  // pinned
+      p.m(i) *= 3.0;
+      p.inv_m(i) = 1.0 / p.m(i);
+    }
+  };
+  for (const bool at_once : {true, false}) {
+    CAPTURE(at_once);
+    clothlab::Scene a = clothlab::parse_scene(windy_cloth("symplectic-euler", "float"), "a.toml");
+    clothlab::Scene b = clothlab::parse_scene(windy_cloth("symplectic-euler", "float"), "b.toml");
+    clothlab::Scene d = clothlab::parse_scene(windy_cloth("symplectic-euler", "double"), "d.toml");
+    for (clothlab::Scene* scene : {&a, &b, &d}) {
+      scene->world.threads = 2;
+      scene->world.step(scene->dt);
+      stop_of(scene->world, scene->dt, 40, at_once && scene == &a);
+      heavier(scene->world);
+    }
+    const Stop stop = stop_of(a.world, a.dt, 40, at_once);
+    CAPTURE(stop.message);
+    stop_of(b.world, b.dt, 40, false);
+    stop_of(d.world, d.dt, 40, false);
+    check_same(a.world, b.world);
+    const double off = (a.world.particles.x - d.world.particles.x).cwiseAbs().maxCoeff();
+    CAPTURE(off);
+    CHECK(off < 1e-5);
+  }
+}
