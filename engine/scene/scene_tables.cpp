@@ -652,7 +652,7 @@ void read_damping(SceneTable& t, Scene& scene) {
 
 // The wind of [aerodynamics] or [drag] (wind.hpp): steady (`wind`) or keyframed (`wind_times`,
 // `wind_values`), with gusts (`gust`, `gust_period`) or not.
-Wind read_wind(SceneTable& t) {
+Wind read_wind(SceneTable& t, const Scene& scene) {
   Wind wind;
   if (t.has("wind") && t.has("wind_values")) {
     t.fail("wind_values", fmt::format("{} gives both wind and wind_values; expected a steady wind "
@@ -670,6 +670,20 @@ Wind read_wind(SceneTable& t) {
   }
   wind.gust = t.vec3("gust", "m/s", Vec3::Zero());
   wind.gust_period = t.number("gust_period", Range::positive("s"), 0.0);
+  // The air drags what it blows on towards its own speed; the guard stops any particle faster
+  // than max_speed. A wind beyond that bound (where a square of its speed may not even be a
+  // number) is refused here, as a pin path beyond the bounds is.
+  const double bound = scene.world.guard.max_speed;
+  if (!(wind.top_speed() <= bound)) {
+    Wind calm = wind;
+    calm.gust_period = 0.0;
+    const char* key =
+        calm.top_speed() > bound ? (wind.table.empty() ? "wind" : "wind_values") : "gust";
+    t.fail(key, fmt::format("{}'s wind reaches {:g} m/s, beyond the guard's max_speed = {:g} "
+                            "m/s, the fastest a particle may move; expected a wind within {:g} "
+                            "m/s (a larger max_speed in [guard] allows more)",
+                            t.display_name(), wind.top_speed(), bound, bound));
+  }
   return wind;
 }
 
@@ -680,7 +694,7 @@ void read_aerodynamics(SceneTable& t, Scene& scene) {
   }
   const double rho = t.number("rho", Range::non_negative("kg/m^3"), kAirDensity);
   const double cd = t.number("cd", Range::non_negative(""), 1.0);
-  const Wind wind = read_wind(t);
+  const Wind wind = read_wind(t, scene);
   auto aerodynamics = std::make_unique<Aerodynamics>(scene.world.triangles, rho, cd, wind.at(0.0));
   if (wind.changes()) aerodynamics->set_gusts(wind);
   scene.world.force_effects.push_back(std::move(aerodynamics));
@@ -691,7 +705,7 @@ void read_drag(SceneTable& t, Scene& scene) {
   const double rho = t.number("rho", Range::non_negative("kg/m^3"), kAirDensity);
   const double cd = t.number("cd", Range::non_negative(""), 0.47);  // a sphere's
   const double area = t.required_number("area", Range::positive("m^2"));
-  const Wind wind = read_wind(t);
+  const Wind wind = read_wind(t, scene);
   auto drag = std::make_unique<FluidDrag>(rho, cd, area, wind.at(0.0));
   if (wind.changes()) drag->set_gusts(wind);
   scene.world.force_effects.push_back(std::move(drag));

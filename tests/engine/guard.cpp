@@ -1,6 +1,7 @@
 // The guard: a blown-up state stops the run with an error that says where and why.
 #include <doctest/doctest.h>
 
+#include <cmath>
 #include <limits>
 #include <string>
 
@@ -16,21 +17,23 @@ using clothlab::Vec3;
 namespace {
 
 // A force effect that misbehaves on purpose: from step `at` on, particle `victim` gets a NaN
-// force (as a division by a zero length would give).
+// force (as a division by a zero length would give), or an infinite one (an overflow).
 class NanInjector final : public clothlab::ForceEffect {
  public:
-  NanInjector(const clothlab::World& world, long at, clothlab::Index victim)
-      : world_(world), at_(at), victim_(victim) {}
+  NanInjector(const clothlab::World& world, long at, clothlab::Index victim,
+              double value = std::numeric_limits<double>::quiet_NaN())
+      : world_(world), at_(at), victim_(victim), value_(value) {}
   std::string_view name() const override { return "nan-injector"; }
   void add_forces(const clothlab::Particles&, const clothlab::Matrix3X&, const clothlab::Matrix3X&,
                   clothlab::Matrix3X& f) const override {
-    if (world_.steps + 1 >= at_) f(1, victim_) = std::numeric_limits<double>::quiet_NaN();
+    if (world_.steps + 1 >= at_) f(1, victim_) = value_;
   }
 
  private:
   const clothlab::World& world_;
   long at_;
   clothlab::Index victim_;
+  double value_;  // the force's y component from step `at` on: NaN, or an infinity
 };
 
 // A force along each particle's own velocity, f = c m v with c = 10 1/s: energy from nowhere,
@@ -111,6 +114,30 @@ TEST_CASE("guard: an injected NaN stops the run at that step naming the particle
     CHECK(what.find("particle 3") != std::string::npos);
     CHECK(what.find("not finite") != std::string::npos);
     CHECK(what.find("gravity, nan-injector; integrator symplectic-euler") != std::string::npos);
+  }
+}
+
+TEST_CASE("guard: a force that overflows on a pinned particle is named as what it is") {
+  // 1/m = 0 holds a pin against any finite force; 0 times an infinite one is a NaN, and the pin
+  // is where it shows. The error says what the forces were, and that the particle is pinned.
+  for (const double bad :
+       {std::numeric_limits<double>::infinity(), std::numeric_limits<double>::quiet_NaN()}) {
+    CAPTURE(bad);
+    clothlab::World world = test::falling_particle("symplectic-euler");
+    world.particles.add(Vec3(1, 1, 0), Vec3::Zero(), 1.0);
+    world.particles.inv_m(1) = 0.0;  // pinned
+    world.force_effects.push_back(std::make_unique<NanInjector>(world, 3, 1, bad));
+    const std::string what = blow_up_message(world);
+    CAPTURE(what);
+    CHECK(what.find("at step 3") != std::string::npos);
+    CHECK(what.find("particle 1 position is not finite") != std::string::npos);
+    CHECK(what.find("The forces the step summed on it were not finite") != std::string::npos);
+    CHECK(what.find("the particle is pinned (1/m = 0)") != std::string::npos);
+    if (std::isinf(bad)) {
+      CHECK(what.find("a force effect overflowed") != std::string::npos);
+    } else {
+      CHECK(what.find("a force effect gave a NaN") != std::string::npos);
+    }
   }
 }
 

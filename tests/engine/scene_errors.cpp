@@ -443,6 +443,10 @@ TEST_CASE("scene error: a pin path that leaves the guard's bounds, at its start 
 TEST_CASE("scene error: a pin path faster than the guard's max_speed") {
   check_bad_scene("pin_path_too_fast.toml");
 }
+TEST_CASE("scene error: a wind or a gust faster than the guard's max_speed") {
+  check_bad_scene("wind_beyond_guard.toml");
+  check_bad_scene("gust_beyond_guard.toml");
+}
 TEST_CASE("scene error: an energy at the start too large for a double") {
   check_bad_scene("infinite_kinetic_energy.toml");
   check_bad_scene("infinite_spring_energy.toml");
@@ -454,7 +458,7 @@ TEST_CASE("scene error: every bad scene file has a test case") {
   for (const auto& entry : fs::directory_iterator(fs::path(CLOTHLAB_TEST_SCENES) / "bad")) {
     if (entry.path().extension() == ".toml") ++files;
   }
-  CHECK(files == 124);
+  CHECK(files == 126);
 }
 
 TEST_CASE("scene error: a missing file") {

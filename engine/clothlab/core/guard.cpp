@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <atomic>
 #include <cmath>
+#include <limits>
+#include <string>
 
 #include <fmt/format.h>
 
@@ -33,6 +35,34 @@ Index first_bad_column(const Matrix3X& a, double bound) {
     }
   }
   return -1;
+}
+
+// Why a particle's state is not finite, as far as the forces the step summed on it tell: an
+// infinite force is a number that overflowed in a force effect (a wind, a stiffness, a mass or a
+// distance too large for its square or product to be held); a NaN, a division by zero or an
+// overflow on the way (infinity times zero, or less infinity). A pinned particle (1/m = 0) stays
+// put under any finite force, but 0 times an infinite force is not a number: the pin is then
+// where the NaN shows first, not where it was born.
+std::string not_finite_advice(const Particles& p, Index i) {
+  std::string advice =
+      "A NaN usually comes from a division by zero (a zero length, two particles at the same "
+      "place) or from values that overflowed after growing without bound";
+  if (i >= p.f.cols() || p.f.col(i).allFinite()) return advice;
+  const Vec3 f = p.f.col(i);
+  const bool overflowed = (f.array().abs() == std::numeric_limits<double>::infinity()).any();
+  advice = fmt::format("The forces the step summed on it were not finite ({}, {}, {}) N: ", f.x(),
+                       f.y(), f.z());
+  advice += overflowed ? "a force effect overflowed (a wind, a stiffness, a mass or a distance "
+                         "too large for the numbers the step computes with)"
+                       : "a force effect gave a NaN: a division by zero (a zero length, two "
+                         "particles at the same place) or a number that overflowed on the way "
+                         "(infinity times zero)";
+  if (i < p.inv_m.size() && p.inv_m(i) == 0.0) {
+    advice +=
+        "; the particle is pinned (1/m = 0), which holds it against any finite force, not "
+        "this one";
+  }
+  return advice;
 }
 
 // What makes a state run away with the world's method, said true for it. A method whose stable dt
@@ -88,8 +118,7 @@ void Guard::check(const World& world, bool before_step) const {
                          "A time step too large for the stiffness is the usual cause (try a "
                          "smaller dt or another integrator); a force with the wrong sign does "
                          "the same at any dt")
-          : "A NaN usually comes from a division by zero (a zero length, two particles at the "
-            "same place) or from values that overflowed after growing without bound";
+          : not_finite_advice(p, i);
   if (before_step) {
     throw SimulationError(
         fmt::format("simulation blew up before step {} (t = {:.6g} s): particle {} {}, and it "

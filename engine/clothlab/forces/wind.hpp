@@ -30,12 +30,13 @@ struct Wind {
   }
 
   // A bound on |v_air(t)| [m/s]: the largest |w| (a keyframe's: |w| along a straight segment is
-  // largest at one of its ends) plus |gust|.
+  // largest at one of its ends) plus |gust|. Norms that do not overflow where the squares would
+  // (stableNorm), so that an absurd wind is named by its speed, not as infinite.
   double top_speed() const {
-    double top = steady.norm();
+    double top = steady.stableNorm();
     for (const Vec3& w : table.y)
-      top = std::max(top, w.norm());
-    return top + (gust_period > 0.0 ? gust.norm() : 0.0);
+      top = std::max(top, w.stableNorm());
+    return top + (gust_period > 0.0 ? gust.stableNorm() : 0.0);
   }
 };
 
