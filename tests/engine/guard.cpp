@@ -95,6 +95,51 @@ TEST_CASE("guard: its advice is true for the method: XPBD, local/global and VBD 
   }
 }
 
+TEST_CASE("guard: VBD with too few sweeps for its springs is told so, and the advice holds") {
+  // ks = 1e7 N/m at dt = 10 ms: one sweep a step leaves the springs stretched and their energy
+  // grows until the energy check stops the run. The advice names the sweeps; ten of them, or a
+  // dt ten times smaller, run the same cloth through.
+  const auto scene_text = [](int iterations, double dt) {
+    return fmt::format(R"([cloth]
+rows = 16
+cols = 16
+spacing = 0.02
+mass = 0.5
+pins = "top-corners"
+[springs]
+ks = 1e7
+[bending]
+ks = 1e5
+[gravity]
+[integrator]
+method = "vbd"
+dt = {}
+duration = 1
+iterations = {}
+)",
+                       dt, iterations);
+  };
+  const auto run = [](const std::string& text) {
+    clothlab::Scene scene = clothlab::parse_scene(text, "vbd.toml");
+    try {
+      for (long s = 0; s < 100; ++s)
+        scene.world.step(scene.dt);
+    } catch (const clothlab::SimulationError& e) {
+      return std::string(e.what());
+    }
+    return std::string();
+  };
+  const std::string what = run(scene_text(1, 0.01));
+  CAPTURE(what);
+  CHECK(what.find("simulation ran away") != std::string::npos);
+  CHECK(what.find("its 1 sweep a step (iterations = 1) may leave them far from solved") !=
+        std::string::npos);
+  CHECK(what.find("more iterations, or a smaller dt") != std::string::npos);
+  CHECK(what.find("a smaller dt is not the cure") == std::string::npos);
+  CHECK(run(scene_text(10, 0.01)).empty());
+  CHECK(run(scene_text(1, 0.001)).empty());
+}
+
 TEST_CASE("guard: an injected NaN stops the run at that step naming the particle") {
   clothlab::World world = test::falling_particle("symplectic-euler");
   for (int i = 0; i < 4; ++i)

@@ -68,16 +68,30 @@ std::string not_finite_advice(const Particles& p, Index i) {
 // What makes a state run away with the world's method, said true for it. A method whose stable dt
 // the springs bound (lesson 08) is usually past that bound; XPBD and the local/global solver have
 // none there, so a smaller dt is no cure on the springs: the cause is elsewhere.
+// A method whose iterations may stop short of solving very stiff springs (VBD with few sweeps)
+// can also leave them stretched, their energy growing from step to step; there more iterations
+// or a smaller dt (an easier solve each step) are the cure.
 std::string likely_cause(const World& world, std::string_view symptom) {
   const std::string_view how =
       world.integrator ? world.integrator->springs_without_dt_limit() : std::string_view();
   if (how.empty()) return std::string(symptom);
+  constexpr std::string_view elsewhere =
+      "a force it takes explicitly that is far too strong for the step (wind, drag, gravitation "
+      "between particles that come close), a pin path that moves too fast, or a force with the "
+      "wrong sign";
+  const std::string iterations = world.integrator->iterations_that_may_stop_short();
+  if (iterations.empty()) {
+    return fmt::format(
+        "{} steps the springs {}, with no time-step limit from their stiffness, so a smaller dt "
+        "is not the cure there: look for {}",
+        world.integrator->name(), how, elsewhere);
+  }
   return fmt::format(
-      "{} steps the springs {}, with no time-step limit from their stiffness, so a smaller dt "
-      "is not the cure there: look for a force it takes explicitly that is far too strong for "
-      "the step (wind, drag, gravitation between particles that come close), a pin path that "
-      "moves too fast, or a force with the wrong sign",
-      world.integrator->name(), how);
+      "{} steps the springs {}, with no time-step limit from their stiffness; but if they are "
+      "very stiff, {} may leave them far from solved, their energy growing from step to step: "
+      "more iterations, or a smaller dt (each step's solve is then easier), is the cure. Else "
+      "look for {}",
+      world.integrator->name(), how, iterations, elsewhere);
 }
 
 }  // namespace

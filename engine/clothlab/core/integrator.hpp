@@ -8,6 +8,7 @@
 // positions of position Verlet), so each world owns its own.
 #pragma once
 
+#include <string>
 #include <string_view>
 
 namespace clothlab {
@@ -37,6 +38,12 @@ class Integrator {
   // constraints; local/global: implicitly, by projections); "" for a method whose stable dt the
   // springs' stiffness bounds (lesson 08). The time-step advisor and the guard's advice ask it.
   virtual std::string_view springs_without_dt_limit() const { return ""; }
+
+  // For such a method whose step solves the springs by iterations that may stop short of the
+  // solution (VBD's sweeps): what the step does, in words that finish "if the springs are very
+  // stiff, ... may leave them far from solved" ("its 1 sweep a step (iterations = 1)"); "" for a
+  // method that cannot leave them so. The guard's advice on a run that blew up gives it.
+  virtual std::string iterations_that_may_stop_short() const { return ""; }
 };
 
 }  // namespace clothlab

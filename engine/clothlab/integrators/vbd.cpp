@@ -1,6 +1,7 @@
 #include "clothlab/integrators/vbd.hpp"
 
 #include <algorithm>
+#include <string>
 #include <vector>
 
 #include "clothlab/core/backend.hpp"
@@ -92,6 +93,11 @@ void Vbd::adaptive_guess(Particles& p, const Vec3& g, double h) {
     p.x.col(i) = x_n_.col(i) + h * p.v.col(i);
     if (a > 0.0) p.x.col(i) += (h * h * a / g_norm) * g;
   }
+}
+
+std::string Vbd::iterations_that_may_stop_short() const {
+  return "its " + std::to_string(iterations) + (iterations == 1 ? " sweep" : " sweeps") +
+         " a step (iterations = " + std::to_string(iterations) + ")";
 }
 
 void Vbd::advance(World& world, double dt) {

@@ -133,6 +133,7 @@ class Vbd final : public Integrator {
   // The external forces are summed once per step.
   int force_evaluations_per_step() const override { return 1; }
   std::string_view springs_without_dt_limit() const override { return "implicitly"; }
+  std::string iterations_that_may_stop_short() const override;
 
   int iterations = 10;     // sweeps over every vertex per step ([integrator] iterations)
   long backend_steps = 0;  // steps whose sweeps the world's backend took (tests/fast/)
