@@ -431,20 +431,35 @@ class FastSprings final : public FastForceOf<S> {
 
   size_t stencil_springs() const override { return layout_.stencil_springs(); }
 
-  // The springs' energy as SpringDampers::potential_energy sums it: each spring's energy in
-  // the set's order, added one after the other. The energies come run by run, several springs
-  // an instruction (energies_of_run), into energies_, each thread of the world the springs of
-  // its own range of the set (a run cut where a range ends: each spring's energy is the same
-  // bits in any lane); the sum then reads them in order, on this thread, so the bits are the
-  // same. On doubles only: the energies the guard checks are the engine's.
+  // The springs' energy as SpringDampers::potential_energy sums it: each spring's energy in the
+  // set's order, block by block (kEnergyBlock), and the blocks' sums in order. The energies come
+  // run by run, several springs an instruction (energies_of_run), into energies_, each thread of
+  // the world the springs of its own range of the set (a run cut where a range ends: each
+  // spring's energy is the same bits in any lane); each thread then sums the blocks that lie
+  // whole in its range, in order, as the readable loop does. This thread sums the blocks that
+  // two ranges share, and then the blocks' sums in order: the same bits. On doubles only: the
+  // energies the guard checks are the engine's.
   bool potential_energy(const World& world, const Matrix3X& x, double& energy) override {
     if constexpr (!std::is_same_v<S, double>) {
       return false;
     } else {
       if (!prepare(world.particles)) return false;  // runs too short to pay: the effect's loop
       const SpringSet& s = springs_.springs();
+      const Index n = static_cast<Index>(s.size());
+      const Index block = static_cast<Index>(kEnergyBlock);
+      const Index blocks = (n + block - 1) / block;
       energies_.resize(s.size());
-      world.for_items(static_cast<Index>(s.size()), [&](Index begin, Index end) {
+      block_sums_.assign(static_cast<size_t>(blocks), 0.0);
+      block_summed_.assign(static_cast<size_t>(blocks), 0);
+      // Block b's sum, its springs' energies added in order.
+      const auto sum_block = [&](Index b) {
+        double sum = 0.0;
+        for (Index k = b * block; k < std::min(n, (b + 1) * block); ++k)
+          sum += energies_[static_cast<size_t>(k)];
+        block_sums_[static_cast<size_t>(b)] = sum;
+        block_summed_[static_cast<size_t>(b)] = 1;
+      };
+      world.for_items(n, [&](Index begin, Index end) {
         // The runs cover the set in its order: the first that ends after `begin`, and on.
         auto run = std::partition_point(runs_.begin(), runs_.end(), [&](const SpringRun& r) {
           return static_cast<Index>(r.k0) + r.length <= begin;
@@ -456,10 +471,16 @@ class FastSprings final : public FastForceOf<S> {
           energies_of_run(k1 - k0, x.data() + 3 * (run->i0 + t), x.data() + 3 * (run->j0 + t),
                           s.ks().data() + k0, s.l0().data() + k0, energies_.data() + k0);
         }
+        // The blocks whole in [begin, end) (the last block ends at n).
+        for (Index b = (begin + block - 1) / block; b * block < end; ++b) {
+          if (std::min(n, (b + 1) * block) <= end) sum_block(b);
+        }
       });
       double sum = 0.0;
-      for (const double e : energies_)
-        sum += e;
+      for (Index b = 0; b < blocks; ++b) {
+        if (!block_summed_[static_cast<size_t>(b)]) sum_block(b);  // one cut by two ranges
+        sum += block_sums_[static_cast<size_t>(b)];
+      }
       energy = sum;
       return true;
     }
@@ -555,8 +576,10 @@ class FastSprings final : public FastForceOf<S> {
   SpringLayout layout_;          // and as the fast path takes them
   bool built_ = false;
   unsigned long version_ = 0, rest_version_ = 0;
-  std::vector<double> energies_;  // potential_energy's, one a spring in the set's order
-  Rounded rounded_;               // the float room's constants (empty on doubles)
+  std::vector<double> energies_;    // potential_energy's, one a spring in the set's order
+  std::vector<double> block_sums_;  // and its blocks' sums (kEnergyBlock springs a block),
+  std::vector<char> block_summed_;  // each marked once summed
+  Rounded rounded_;                 // the float room's constants (empty on doubles)
 };
 
 template <class S>

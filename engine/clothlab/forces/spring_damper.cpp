@@ -131,8 +131,11 @@ void SpringDampers::add_forces(const Particles& /*p*/, const Matrix3X& x, const 
 double SpringDampers::potential_energy(const Particles& /*p*/, const Matrix3X& x) const {
   const SpringSet& s = springs_;
   double energy = 0.0;
-  for (size_t k = 0; k < s.size(); ++k) {
-    energy += spring_energy(x.col(s.i(k)), x.col(s.j(k)), s.ks(k), s.l0(k));
+  for (size_t b = 0; b < s.size(); b += kEnergyBlock) {  // block by block (kEnergyBlock)
+    double block = 0.0;
+    for (size_t k = b; k < std::min(s.size(), b + kEnergyBlock); ++k)
+      block += spring_energy(x.col(s.i(k)), x.col(s.j(k)), s.ks(k), s.l0(k));
+    energy += block;
   }
   return energy;
 }
