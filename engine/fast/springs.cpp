@@ -563,13 +563,43 @@ class FastSprings final : public FastForceOf<S> {
     const Index r0 = std::max<Index>(0, (p_begin - upper - stencil.length) / stencil.stride);
     const Index r1 =
         p_end <= lower ? 0 : std::min(stencil.rows, (p_end - lower) / stencil.stride + 1);
-    for (Index r = r0; r < r1; ++r) {
+    const auto row = [&](Index r) {
       const Index shift = r * stencil.stride;
       add_run({stencil.i0 + shift, stencil.j0 + shift, stencil.length, ks, kd,
                l0 + stencil.row_l0[static_cast<size_t>(r)], true},
               p_begin, p_end, x, v, f);
+    };
+    // Rows [whole0, whole1) lie wholly in range, both ends of every spring: add_rows_direct
+    // (springs that go straight to their ends, kDirectGap) or add_rows_buffered (a row that fits
+    // one chunk) takes them without the bookkeeping add_run does for a row that may be cut. Rows
+    // in order, so the same sums.
+    const bool direct = upper - lower >= kDirectGap;
+    Index whole0 = r1, whole1 = r1;
+    if ((direct || stencil.length <= kChunk) && r0 < r1) {
+      const Index first =
+          p_begin <= lower ? 0 : (p_begin - lower + stencil.stride - 1) / stencil.stride;
+      const Index past = p_end < upper + stencil.length
+                             ? 0
+                             : (p_end - upper - stencil.length) / stencil.stride + 1;
+      whole0 = std::clamp(first, r0, r1);
+      whole1 = std::clamp(past, whole0, r1);
     }
+    for (Index r = r0; r < whole0; ++r)
+      row(r);
+    if (whole0 < whole1 && direct) add_rows_direct(stencil, ks, kd, l0, whole0, whole1, x, v, f);
+    if (whole0 < whole1 && !direct) add_rows_buffered(stencil, ks, kd, l0, whole0, whole1, x, v, f);
+    for (Index r = whole1; r < r1; ++r)
+      row(r);
   }
+  // Rows [r_begin, r_end) of a stencil whose springs go straight to their ends, every end in the
+  // thread's range: each row as add_run_direct takes a row wholly in range, the whole vectors and
+  // then the last, masked.
+  void add_rows_direct(const SpringStencil& stencil, const S* ks, const S* kd, const S* l0,
+                       Index r_begin, Index r_end, const SoA& x, const SoA& v, SoA& f) const;
+  // The same for a stencil whose springs' ends are fewer than kDirectGap apart, rows of at most
+  // kChunk springs: each row as add_run takes a row wholly in range, in one chunk.
+  void add_rows_buffered(const SpringStencil& stencil, const S* ks, const S* kd, const S* l0,
+                         Index r_begin, Index r_end, const SoA& x, const SoA& v, SoA& f) const;
 
   const SpringDampers& springs_;
   std::vector<SpringRun> runs_;  // the set's runs, as spring_runs cuts them
@@ -702,6 +732,61 @@ void FastSprings<S>::add_run_direct(const RunView<S>& run, Index up_begin, Index
   springs(up_begin, std::min(up_end, lo_begin), true, false);
   springs(both_begin, both_end, true, true);
   springs(std::max(up_end, lo_begin), lo_end, false, true);
+}
+
+template <class S>
+void FastSprings<S>::add_rows_direct(const SpringStencil& stencil, const S* ks, const S* kd,
+                                     const S* l0, Index r_begin, Index r_end, const SoA& x,
+                                     const SoA& v, SoA& f) const {
+  const Index lower = std::min(stencil.i0, stencil.j0), upper = std::max(stencil.i0, stencil.j0);
+  const bool upper_is_j = stencil.j0 > stencil.i0;
+  const auto kernel = upper_is_j ? run_kernel_direct<S, true, true, true, true>
+                                 : run_kernel_direct<S, true, false, true, true>;
+  const auto masked = upper_is_j ? run_kernel_direct<S, true, true, true, true, true>
+                                 : run_kernel_direct<S, true, false, true, true, true>;
+  constexpr Index kLanes = kVectorLanes<S>;
+  const Index length = stencil.length;
+  const Index rest = kWholeVectorEnds<S> && length > kLanes ? length % kLanes : 0;
+  for (Index r = r_begin; r < r_end; ++r) {
+    const Index shift = r * stencil.stride;
+    const S* const row_l0 = l0 + stencil.row_l0[static_cast<size_t>(r)];
+    // Springs [first, last) of row r (as add_run_direct's run_from, on a uniform run).
+    const auto springs = [&](auto kernel_of, Index first, Index last, Index from) {
+      const Index i = stencil.i0 + shift + first, j = stencil.j0 + shift + first;
+      kernel_of(last - first, x.cols(), v.cols(), f.cols(), x.data() + i, x.data() + j,
+                v.data() + i, v.data() + j, ks, kd, row_l0 + first,
+                f.data() + upper + shift + first, f.data() + lower + shift + first, from);
+    };
+    springs(kernel, 0, length - rest, 0);
+    if (rest > 0) springs(masked, length - kLanes, length, kLanes - rest);
+  }
+}
+
+template <class S>
+void FastSprings<S>::add_rows_buffered(const SpringStencil& stencil, const S* ks, const S* kd,
+                                       const S* l0, Index r_begin, Index r_end, const SoA& x,
+                                       const SoA& v, SoA& f) const {
+  const Index n = f.cols();
+  const Index lower = std::min(stencil.i0, stencil.j0), upper = std::max(stencil.i0, stencil.j0);
+  const Index gap = upper - lower, length = stencil.length;
+  const bool upper_is_j = stencil.j0 > stencil.i0;
+  S f1[3 * kChunk];
+  for (Index r = r_begin; r < r_end; ++r) {
+    const Index shift = r * stencil.stride;
+    const Index i = stencil.i0 + shift, j = stencil.j0 + shift;
+    forces_in_vectors<S, true>(length, x.cols(), v.cols(), x.data() + i, x.data() + j, v.data() + i,
+                               v.data() + j, ks, kd, l0 + stencil.row_l0[static_cast<size_t>(r)],
+                               f1, f1 + kChunk, f1 + 2 * kChunk);
+    // As add_run on one chunk with every end in range: springs [length - gap, length) give only
+    // their upper ends a share, [0, length - gap) their upper ends and the lower ends gap
+    // further both, and [0, gap) only their lower ends; each particle in one of the three.
+    S* const f_upper = f.data() + upper + shift;
+    S* const f_lower = f.data() + lower + shift;
+    const Index both = std::max<Index>(0, length - gap);
+    if (both < length) add_shares(length - both, n, f1 + both, f_upper + both, !upper_is_j);
+    if (both > 0) add_both_shares(both, n, gap, f1, f_upper, upper_is_j);
+    add_shares(std::min(gap, length), n, f1, f_lower, upper_is_j);
+  }
 }
 
 }  // namespace
