@@ -459,6 +459,26 @@ class FastSprings final : public FastForceOf<S> {
         block_sums_[static_cast<size_t>(b)] = sum;
         block_summed_[static_cast<size_t>(b)] = 1;
       };
+      // Blocks [b0, b1), each in order as sum_block does: four full blocks at a time, four sums
+      // that do not wait on each other (one addition after another is the loop's whole cost).
+      const auto sum_blocks = [&](Index b0, Index b1) {
+        const double* const e = energies_.data();
+        Index b = b0;
+        for (; b + 4 <= b1 && (b + 4) * block <= n; b += 4) {
+          const double* const e0 = e + b * block;
+          double sums[4] = {0.0, 0.0, 0.0, 0.0};
+          for (Index k = 0; k < block; ++k) {
+            for (Index q = 0; q < 4; ++q)
+              sums[q] += e0[q * block + k];
+          }
+          for (Index q = 0; q < 4; ++q) {
+            block_sums_[static_cast<size_t>(b + q)] = sums[q];
+            block_summed_[static_cast<size_t>(b + q)] = 1;
+          }
+        }
+        for (; b < b1; ++b)
+          sum_block(b);
+      };
       world.for_items(n, [&](Index begin, Index end) {
         // The runs cover the set in its order: the first that ends after `begin`, and on.
         auto run = std::partition_point(runs_.begin(), runs_.end(), [&](const SpringRun& r) {
@@ -472,9 +492,11 @@ class FastSprings final : public FastForceOf<S> {
                           s.ks().data() + k0, s.l0().data() + k0, energies_.data() + k0);
         }
         // The blocks whole in [begin, end) (the last block ends at n).
-        for (Index b = (begin + block - 1) / block; b * block < end; ++b) {
-          if (std::min(n, (b + 1) * block) <= end) sum_block(b);
-        }
+        const Index b0 = (begin + block - 1) / block;
+        Index b1 = b0;
+        while (b1 * block < end && std::min(n, (b1 + 1) * block) <= end)
+          ++b1;
+        sum_blocks(b0, b1);
       });
       double sum = 0.0;
       for (Index b = 0; b < blocks; ++b) {
