@@ -26,7 +26,9 @@
 //
 // A grid's rows come as stencils (SpringStencil, springs.hpp): the rows of a family taken one
 // after the other, in the set's order, as the runs they replace would be, each through the same
-// loops as a run (RunView), so the sums are the same, bit for bit. What a stencil saves is the
+// loops as a run (RunView), so the sums are the same, bit for bit; a row wholly in a thread's
+// range goes to those loops directly (add_rows_direct, add_rows_buffered), without the
+// bookkeeping of a row that the range may cut. What a stencil saves is the
 // rest lengths' stream: its rows read theirs from a few distinct rows of them, which stay in the
 // first-level cache, and ks and kd once. SPEED.md measures what that is worth.
 //
@@ -799,9 +801,10 @@ void FastSprings<S>::add_rows_buffered(const SpringStencil& stencil, const S* ks
     forces_in_vectors<S, true>(length, x.cols(), v.cols(), x.data() + i, x.data() + j, v.data() + i,
                                v.data() + j, ks, kd, l0 + stencil.row_l0[static_cast<size_t>(r)],
                                f1, f1 + kChunk, f1 + 2 * kChunk);
-    // As add_run on one chunk with every end in range: springs [length - gap, length) give only
-    // their upper ends a share, [0, length - gap) their upper ends and the lower ends gap
-    // further both, and [0, gap) only their lower ends; each particle in one of the three.
+    // As add_run on one chunk with every end in range: particle upper + t takes both its
+    // shares at once for t in [0, length - gap) (the upper end of spring t, the lower end of
+    // spring t + gap), only spring t's for t in [length - gap, length); particle lower + t only
+    // spring t's for t in [0, gap). Each particle in one of the three.
     S* const f_upper = f.data() + upper + shift;
     S* const f_lower = f.data() + lower + shift;
     const Index both = std::max<Index>(0, length - gap);
