@@ -336,19 +336,21 @@ void add_shares(Index count, Index n, const S* __restrict f1, S* __restrict f, b
 // chunk takes both shares in one visit, upper first: f[c][t] = (f[c][t] -+ f1[c][t]) +- f1[c][t +
 // gap], for t = 0 .. count - 1 (- then + when the upper ends are the j ends). Two passes would
 // read back, one to three places over, a value just stored by a vector instruction, which the
-// processor cannot forward from its store buffer: a stall on every load.
+// processor cannot forward from its store buffer: a stall on every load. f's components are n
+// apart, f1's `stride` (kChunk in add_run's buffer).
 //
 // In whole vectors, as add_to_row (vectorise.hpp): the last vector's values made from those
 // before the loop, stored after it.
 template <class S, bool UpperIsJ>
-void add_both_shares_of(Index count, Index n, Index gap, const S* __restrict f1, S* __restrict f) {
+void add_both_shares_of(Index count, Index n, Index gap, const S* __restrict f1, S* __restrict f,
+                        Index stride) {
   constexpr Index kLanes = kVectorLanes<S>;
   const auto both = [](S fc, S up, S lo) { return UpperIsJ ? (fc - up) + lo : (fc + up) - lo; };
   const bool tail = kWholeVectorEnds<S> && count > kLanes && count % kLanes != 0;
   const Index last = count - kLanes, whole = count - count % kLanes;
   for (int c = 0; c < 3; ++c) {
     S* __restrict fc = f + c * n;
-    const S* __restrict up = f1 + c * kChunk;
+    const S* __restrict up = f1 + c * stride;
     const S* __restrict lo = up + gap;
     if (!tail) {
       for (Index t = 0; t < count; ++t)
@@ -365,8 +367,10 @@ void add_both_shares_of(Index count, Index n, Index gap, const S* __restrict f1,
   }
 }
 template <class S>
-void add_both_shares(Index count, Index n, Index gap, const S* f1, S* f, bool upper_is_j) {
-  (upper_is_j ? add_both_shares_of<S, true> : add_both_shares_of<S, false>)(count, n, gap, f1, f);
+void add_both_shares(Index count, Index n, Index gap, const S* f1, S* f, bool upper_is_j,
+                     Index stride = kChunk) {
+  (upper_is_j ? add_both_shares_of<S, true> : add_both_shares_of<S, false>)(count, n, gap, f1, f,
+                                                                            stride);
 }
 
 }  // namespace
@@ -794,23 +798,30 @@ void FastSprings<S>::add_rows_buffered(const SpringStencil& stencil, const S* ks
   const Index lower = std::min(stencil.i0, stencil.j0), upper = std::max(stencil.i0, stencil.j0);
   const Index gap = upper - lower, length = stencil.length;
   const bool upper_is_j = stencil.j0 > stencil.i0;
-  S f1[3 * kChunk];
+  // Each component's forces with kDirectGap places on either side (gap < kDirectGap), which hold
+  // zeros that leave a particle as it was: the upper share of a spring before the row's first
+  // (-f1 on a j end, +f1 on an i end: +0.0 subtracted, -0.0 added) and the lower share of one
+  // after its last (-0.0 added, +0.0 subtracted). Then every particle of the row, lower + q for q
+  // in [0, length + gap), takes both its shares in one visit, upper first, as add_both_shares
+  // does: f = (f -+ f1[q - gap]) +- f1[q]. Those with one share take the other as a zero that
+  // changes no bit (+0.0 and -0.0 included), so the sums are add_run's.
+  constexpr Index kPad = kDirectGap, kStride = kChunk + 2 * kPad;
+  S buffer[3 * kStride];
+  S* const f1 = buffer + kPad;  // component c of spring t at f1[c kStride + t]
+  const S before = upper_is_j ? S(0.0) : S(-0.0), after = upper_is_j ? S(-0.0) : S(0.0);
+  for (int c = 0; c < 3; ++c) {
+    for (Index t = 0; t < gap; ++t) {
+      f1[c * kStride - gap + t] = before;
+      f1[c * kStride + length + t] = after;
+    }
+  }
   for (Index r = r_begin; r < r_end; ++r) {
     const Index shift = r * stencil.stride;
     const Index i = stencil.i0 + shift, j = stencil.j0 + shift;
     forces_in_vectors<S, true>(length, x.cols(), v.cols(), x.data() + i, x.data() + j, v.data() + i,
                                v.data() + j, ks, kd, l0 + stencil.row_l0[static_cast<size_t>(r)],
-                               f1, f1 + kChunk, f1 + 2 * kChunk);
-    // As add_run on one chunk with every end in range: particle upper + t takes both its
-    // shares at once for t in [0, length - gap) (the upper end of spring t, the lower end of
-    // spring t + gap), only spring t's for t in [length - gap, length); particle lower + t only
-    // spring t's for t in [0, gap). Each particle in one of the three.
-    S* const f_upper = f.data() + upper + shift;
-    S* const f_lower = f.data() + lower + shift;
-    const Index both = std::max<Index>(0, length - gap);
-    if (both < length) add_shares(length - both, n, f1 + both, f_upper + both, !upper_is_j);
-    if (both > 0) add_both_shares(both, n, gap, f1, f_upper, upper_is_j);
-    add_shares(std::min(gap, length), n, f1, f_lower, upper_is_j);
+                               f1, f1 + kStride, f1 + 2 * kStride);
+    add_both_shares(length + gap, n, gap, f1 - gap, f.data() + lower + shift, upper_is_j, kStride);
   }
 }
 
