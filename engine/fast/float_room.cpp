@@ -109,8 +109,8 @@ float float_at_most(double bound) {
 // above, but in float, against the bounds rounded down to floats (float_at_most: the same test),
 // and with the count of values outside kept as a flag of the floats' width: widening 16 floats to
 // doubles, and their tests to 64-bit counts, took more instructions than the move itself; for
-// the same reason 1/m comes rounded to float once for the run of steps (inv_m, FloatRoom::inv_m_:
-// the same float as rounded here). The forces stay in the copies.
+// the same reason 1/m comes rounded to float once for the run of steps (inv_m, FloatRoom::inv_m_;
+// rounded once or as read, each is the same float). The forces stay in the copies.
 template <bool Symplectic>
 [[gnu::noinline]] bool move_in_float_resident(
     Index begin, Index end, float dt, const float* __restrict x, Index nx,

@@ -140,7 +140,7 @@ void add_spring_family(SpringSet& springs, const std::vector<std::pair<Index, In
 // SpringDampers::potential_energy sums its springs' energies in blocks of this many, each block
 // in order, then the blocks' sums in order: for a set of one block (up to 4096 springs) the same
 // number as one sum in order, and for a larger one a sum the engine room can split between its
-// threads, a block to a thread, to the same bits (engine/fast/springs.cpp).
+// threads, each summing whole blocks, to the same bits (engine/fast/springs.cpp).
 inline constexpr size_t kEnergyBlock = 4096;
 
 // The force effect of one or more spring families: "springs" (structural, shear and springs
