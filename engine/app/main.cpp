@@ -383,6 +383,10 @@ int main(int argc, char** argv) {
                  particle_count(scene), scene.world.effects_in_play(), scene.dt, scene.duration,
                  scene.step_count());
       print_scene_warnings(scene, scene.output.velocities, scene.output.springs, scene.output.npy);
+      // A run refuses these where it would write them to a file of floats (run_scene).
+      for (const auto& note : {scene.position_beyond_float, scene.velocity_beyond_float}) {
+        if (note) fmt::print(stderr, "warning: {}\n", shown(note->text()));
+      }
       const TimeStepAdvice advice = advise_time_step(scene.world, scene.dt, scene.step_count());
       if (advice.bounds.omega_max > 0.0) {
         fmt::print("  stiffest mode: w <= {:.4g} rad/s; stable time step for {}: {}\n",

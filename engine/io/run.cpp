@@ -8,6 +8,7 @@
 #include <csignal>
 #include <cstring>
 #include <string>
+#include <utility>
 
 #include <fmt/format.h>
 
@@ -139,6 +140,14 @@ RunReport run_scene(Scene& scene, const RunOutputs& outputs, const ProgressFn& p
   StopSignals stop_signals;
   // Everything that can be found wrong with the outputs is found before the first step.
   const bool page = !outputs.html.empty();
+  // A start past a float's range, in a file of floats: refused at its place in the scene.
+  const bool npy = outputs.npy || scene.output.npy;
+  const bool velocities = outputs.velocities || scene.output.velocities;
+  for (const auto& [note, refused] : {std::pair{&scene.position_beyond_float, page || npy},
+                                      std::pair{&scene.velocity_beyond_float, npy && velocities}}) {
+    if (*note && refused)
+      throw SceneError((*note)->source, (*note)->line, (*note)->column, (*note)->message);
+  }
   // A page outside the folder is checked first, so that a bad --html creates no folder; a page
   // inside it is checked by RunFolder, before it clears anything there.
   const bool page_inside = page && same_place(outputs.html.parent_path(), outputs.dir);
@@ -147,8 +156,7 @@ RunReport run_scene(Scene& scene, const RunOutputs& outputs, const ProgressFn& p
       page && !page_inside ? check_page_target(outputs.html, outputs.force) : PageFolderLock();
   RunFolder folder(outputs.dir, outputs.force,
                    page_inside ? outputs.html : std::filesystem::path());
-  FrameWriter writer(folder.folder(), outputs.velocities || scene.output.velocities,
-                     outputs.springs || scene.output.springs, outputs.npy || scene.output.npy,
+  FrameWriter writer(folder.folder(), velocities, outputs.springs || scene.output.springs, npy,
                      scene.world.particles.size(), page);
   MeshExporter meshes(folder.folder(), "frames", outputs.obj, outputs.vtk);
   RunReport report;

@@ -142,6 +142,11 @@ void SceneTable::fail(std::string_view key, const std::string& message) const {
 
 void SceneTable::warn(Scene& scene, std::string_view key, const std::string& message,
                       std::optional<size_t> element) const {
+  scene.warnings.push_back(at(key, message, element));
+}
+
+SceneWarning SceneTable::at(std::string_view key, const std::string& message,
+                            std::optional<size_t> element) const {
   const toml::table& table = as_table(node_);
   const toml::node* value = table.get(key);
   if (value && element) {
@@ -149,8 +154,8 @@ void SceneTable::warn(Scene& scene, std::string_view key, const std::string& mes
     if (array && *element < array->size()) value = array->get(*element);
   }
   const toml::source_region where = value ? value->source() : table.source();
-  scene.warnings.push_back({source_, static_cast<long>(where.begin.line),
-                            static_cast<long>(where.begin.column), message});
+  return {source_, static_cast<long>(where.begin.line), static_cast<long>(where.begin.column),
+          message};
 }
 
 namespace {

@@ -84,6 +84,13 @@ struct Scene {
   std::optional<SolidLattice> solid;
   std::vector<PinPath> pin_paths;  // the bodies' moving pins: the "moving_pins" effect
 
+  // The first start, if any, at a position or a velocity past what a 32-bit float holds
+  // (3.4e38), which the guard's bounds let through when they are widened: where it is in the
+  // file and what is wrong. The CSV files keep doubles, but the page and the .npy files keep
+  // floats, so run_scene refuses such a start before it writes anything when it would write one
+  // of those; `clothlab validate` warns of it.
+  std::optional<SceneWarning> position_beyond_float, velocity_beyond_float;
+
   long step_count() const;  // steps needed to cover `duration`
 };
 

@@ -69,6 +69,9 @@ class SceneTable {
   // table itself when the key is absent) to `scene`.
   void warn(Scene& scene, std::string_view key, const std::string& message,
             std::optional<size_t> element = std::nullopt) const;
+  // The same warning, returned: `message` at `key` (or at the table).
+  SceneWarning at(std::string_view key, const std::string& message,
+                  std::optional<size_t> element = std::nullopt) const;
 
   // Raises a SceneError for the first key that is not in `known` (names separated by spaces),
   // suggesting the nearest known name.

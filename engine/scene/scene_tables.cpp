@@ -45,10 +45,34 @@ void check_particle_mass(SceneTable& t, std::string_view key, double m, const st
   }
 }
 
+// The largest number a 32-bit float holds (3.4e38): the page and the .npy files keep floats.
+constexpr double kFloatFileMax = std::numeric_limits<float>::max();
+
+// Notes in `scene` the first start past what a float holds, at `key`: a position (x [m]) or a
+// velocity (v [m/s]) that the guard's widened bounds let through. A run that would write it to
+// a file of floats refuses it there (Scene::position_beyond_float).
+void note_beyond_float(const SceneTable& t, std::string_view key, Scene& scene, const Vec3& x,
+                       bool position, std::string_view what) {
+  std::optional<SceneWarning>& note =
+      position ? scene.position_beyond_float : scene.velocity_beyond_float;
+  if (note || (x.array().abs() <= kFloatFileMax).all()) return;
+  note = t.at(key, position ? fmt::format("{} starts at ({}, {}, {}) m, beyond what a 32-bit float "
+                                          "holds ({:.6g}), which the page and positions.npy keep; "
+                                          "expected |x|, |y|, |z| <= {:.6g} m, or a run that "
+                                          "writes the CSV files alone (--no-html, format = "
+                                          "\"csv\")",
+                                          what, x.x(), x.y(), x.z(), kFloatFileMax, kFloatFileMax)
+                            : fmt::format("{} starts at velocity ({}, {}, {}) m/s, beyond what a "
+                                          "32-bit float holds ({:.6g}), which velocities.npy "
+                                          "keeps; expected each component within {:.6g} m/s, or "
+                                          "velocities in velocities.csv (format = \"csv\")",
+                                          what, x.x(), x.y(), x.z(), kFloatFileMax, kFloatFileMax));
+}
+
 // The guard stops a run at its first step if a particle starts beyond its bounds, so such a scene
 // is refused here, where the line can be named; this also keeps a huge spacing or coordinate from
 // overflowing to infinity. [guard] is read before any particle.
-void check_within_guard(SceneTable& t, std::string_view key, const Scene& scene, Index i,
+void check_within_guard(SceneTable& t, std::string_view key, Scene& scene, Index i,
                         std::string_view what) {
   const double bound = scene.world.guard.max_position;
   const Vec3 x = scene.world.particles.x.col(i);
@@ -59,6 +83,7 @@ void check_within_guard(SceneTable& t, std::string_view key, const Scene& scene,
                             "allows more)",
                             what, x.x(), x.y(), x.z(), bound, bound));
   }
+  note_beyond_float(t, key, scene, x, true, what);
 }
 
 // [[particle]]: one point mass (lesson 01).
@@ -81,6 +106,7 @@ void read_particle(SceneTable& t, Scene& scene) {
                                    "larger max_speed in [guard] allows more)",
                                    t.display_name(), v.x(), v.y(), v.z(), max_speed, max_speed));
   }
+  note_beyond_float(t, "velocity", scene, v, false, t.display_name());
   const Index i = scene.world.particles.add(x, v, m);
   check_within_guard(t, "position", scene, i, t.display_name());
   if (pinned) pin(scene.world.particles, i);
@@ -105,6 +131,10 @@ void read_body_motion(SceneTable& t, Scene& scene, Index first, Index count,
                        "max_speed = {} m/s; expected each component within {} m/s (a larger "
                        "max_speed in [guard] allows more)",
                        what, i - first, v.x(), v.y(), v.z(), max_speed, max_speed));
+  }
+  for (Index i = first; i < first + count; ++i) {
+    note_beyond_float(t, t.has("spin") ? "spin" : "velocity", scene, p.v.col(i), false,
+                      fmt::format("{} particle {}", what, i - first));
   }
 }
 

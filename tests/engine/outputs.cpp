@@ -600,22 +600,78 @@ fps = 100
   CHECK(std::count(energy.begin(), energy.end(), '\n') == 1 + 4);
   CHECK(read_all(dir / "view.html").find("\"times\":[0.0,0.01,0.02,0.03]") != std::string::npos);
 
-  // velocities.npy holds the velocity of 1e40 as a float: refused at frame 0.
+  // velocities.npy would hold the starting velocity of 1e40 as a float: the run refuses it at
+  // its place in the scene, before it writes anything (the files of the run above are kept).
   scene = clothlab::parse_scene(text + "format = \"npy\"\nvelocities = true\n", "<fast>");
+  REQUIRE(scene.velocity_beyond_float);
+  CHECK_FALSE(scene.position_beyond_float);
   clothlab::RunOutputs outputs = clothlab::RunOutputs::in(dir);
   outputs.html.clear();
   CHECK_THROWS_WITH_AS(clothlab::run_scene(scene, outputs),
-                       doctest::Contains("frame 0 (after step 0, t = 0 s) would write a velocity "
-                                         "[m/s] of 1e+40: more than a 32-bit float holds "
-                                         "(3.4e+38), which velocities.npy keeps"),
-                       clothlab::SimulationError);
-  CHECK(read_all(dir / "positions.npy").find("'shape': (0, 1, 3)") != std::string::npos);
+                       "<fast>:7:12: [[particle]] #1 starts at velocity (1e+40, 0, 0) m/s, beyond "
+                       "what a 32-bit float holds (3.40282e+38), which velocities.npy keeps; "
+                       "expected each component within 3.40282e+38 m/s, or velocities in "
+                       "velocities.csv (format = \"csv\")",
+                       clothlab::SceneError);
+  CHECK(std::count(energy.begin(), energy.end(), '\n') == 1 + 4);
+  CHECK(read_all(dir / "energy.csv") == energy);
 
   // The CSV files alone keep doubles: the run goes to its end.
   scene = clothlab::parse_scene(text, "<fast>");
   CHECK(clothlab::run_scene(scene, outputs).frames == 11);
   energy = read_all(dir / "energy.csv");
   CHECK(std::count(energy.begin(), energy.end(), '\n') == 1 + 11);
+
+  // A start past 3.4e38 m: the page, or positions.npy, would hold it as inf. Refused at the
+  // key that put it there, the folder untouched; the CSV files alone take it.
+  const std::string far = R"(
+[guard]
+max_position = 1e300
+[[particle]]
+position = [0, 1e39, 0]
+mass = 1
+[cloth]
+rows = 2
+cols = 2
+spacing = 1e30
+origin = [0, 0, 0]
+mass = 1
+[integrator]
+dt = 0.01
+duration = 0.1
+[output]
+fps = 100
+)";
+  scene = clothlab::parse_scene(far, "<far>");
+  REQUIRE(scene.position_beyond_float);
+  CHECK_FALSE(scene.velocity_beyond_float);
+  const std::string position_error =
+      "<far>:5:12: [[particle]] #1 starts at (0, 1e+39, 0) m, beyond what a 32-bit float holds "
+      "(3.40282e+38), which the page and positions.npy keep; expected |x|, |y|, |z| <= "
+      "3.40282e+38 m, or a run that writes the CSV files alone (--no-html, format = \"csv\")";
+  CHECK(scene.position_beyond_float->text() == position_error);
+  CHECK_THROWS_WITH_AS(clothlab::run_scene(scene, dir), position_error.c_str(),
+                       clothlab::SceneError);
+  CHECK(read_all(dir / "energy.csv") == energy);
+  outputs.npy = true;
+  CHECK_THROWS_WITH_AS(clothlab::run_scene(scene, outputs), position_error.c_str(),
+                       clothlab::SceneError);
+  outputs.npy = false;
+  CHECK(clothlab::run_scene(scene, outputs).frames == 11);
+  // A body's start: its velocity, at the key that set it.
+  const clothlab::Scene moving = clothlab::parse_scene(
+      "[guard]\nmax_speed = 1e300\n[cloth]\nrows = 2\ncols = 2\nspacing = 1\nmass = 1\n"
+      "velocity = [0, 0, -1e39]\n[integrator]\ndt = 0.01\nduration = 0.1\n",
+      "<moving>");
+  REQUIRE(moving.velocity_beyond_float);
+  CHECK(moving.velocity_beyond_float->text().starts_with(
+      "<moving>:8:12: the cloth's particle 0 starts at velocity (0, 0, -1e+39) m/s, beyond what "
+      "a 32-bit float holds (3.40282e+38), which velocities.npy keeps"));
+  // Within a float's range (the cloth's far corner, 1e30 m): no note.
+  CHECK_FALSE(clothlab::parse_scene(far.substr(0, far.find("[[particle]]")) +
+                                        far.substr(far.find("[cloth]")),
+                                    "<near>")
+                  .position_beyond_float);
 }
 
 namespace {

@@ -246,8 +246,8 @@ TEST_CASE("solid: every spring once with the length of its family, and an outwar
 }
 
 TEST_CASE("solid: a jelly cube dropped on the ground stays finite and comes to rest above it") {
-  clothlab::Scene scene = clothlab::load_scene_file(std::string(CLOTHLAB_SOURCE_DIR) +
-                                                    "/lessons/09-ropes-and-solids/jelly-cube.toml");
+  clothlab::Scene scene = clothlab::load_scene_file(std::filesystem::path(CLOTHLAB_SOURCE_DIR) /
+                                                    "lessons/09-ropes-and-solids/jelly-cube.toml");
   clothlab::World& w = scene.world;
   REQUIRE(scene.solid);
   CHECK(test::springs_of(w).size() == 300 + 480 + 256);  // a 5 x 5 x 5 lattice, see the scene
