@@ -31,7 +31,9 @@ namespace clothlab::fast {
 // add(b0, b1, x, v, f) adds every force effect's forces on particles [b0, b1) into f, from x
 // and v; move(c0, c1, now, next) moves particles [c0, c1) from now's x, v and f into next's x and
 // v, and returns whether they are within the guard's bounds. Particles go through each step
-// `block` at a time: their forces summed, then moved, in chunks of `chunk`.
+// `block` at a time: their forces cleared and summed, then moved, in chunks of `chunk`. A block's
+// forces are cleared just before its effects add to them, while they are still in the cache:
+// an effect adds to the particles of the block it is given and to no others (FastForceOf::add).
 template <class S, class Add, class Move>
 BackendSteps resident_steps(World& world, double dt, long count, ResidentOf<S>& r, Index block,
                             Index chunk, Add add, Move move) {
@@ -59,9 +61,9 @@ BackendSteps resident_steps(World& world, double dt, long count, ResidentOf<S>& 
     CopiesOf<S>* next = &r.b;
     try {
       for (long k = 1;; ++k) {
-        now->f.middleCols(begin, end - begin).setZero();
         for (Index b0 = begin; b0 < end; b0 += block) {
           const Index b1 = std::min(b0 + block, end);
+          now->f.middleCols(b0, b1 - b0).setZero();
           add(b0, b1, now->x, now->v, now->f);
           for (Index c0 = b0; c0 < b1; c0 += chunk) {
             if (!move(c0, std::min(c0 + chunk, b1), *now, *next)) end_within = false;
