@@ -16,6 +16,9 @@
 //   bare            the engine's force effects and Euler kernel on a state that stays in the fast
 //                   layout, with no copies and no guard: what the reference would cost if the
 //                   engine kept its state that way (1 thread and every core)
+//   plain           the anchor: the same step as a careful first engine writes it, one loop a
+//                   stage over a list of springs and arrays of x, y and z, one thread, with the
+//                   reference's time over its own: what the engine's engineering buys
 //   kernel          the spring kernel alone (spring_forces_of_run, the fast path's inner loop)
 //                   on 256 springs whose data stay in the first-level cache: the least any step
 //                   built on the spring kernel can cost per spring on this machine
@@ -26,9 +29,9 @@
 //   implicit        implicit Euler on a stiff cloth: the whole step, then its assembly (forces,
 //                   Jacobians, the matrix) and its linear solve
 //
-// All variants but `kernel` and `implicit` compute the same physics; the naive, bare and float
-// ones are checked against the engine after a few steps, and the readable and fast paths agree
-// bit for bit (a test checks it).
+// All variants but `kernel` and `implicit` compute the same physics; the naive, bare, plain and
+// float ones are checked against the engine after a few steps, and the readable and fast paths
+// agree bit for bit (a test checks it).
 #include <unistd.h>
 
 #include <algorithm>
@@ -430,6 +433,145 @@ struct BareCloth {
   }
 };
 
+// --- A plain structure-of-arrays step: the anchor -------------------------------------------
+//
+// What a careful first engine looks like, the one a fast engine has to beat: every spring in one
+// list held in arrays (the ends i and j, ks, kd, l0; the world's spring effects one after the
+// other, each in its set's order), the particles' x, v and f an array per coordinate, and a step
+// as the lecture writes it, a loop a stage: clear f; for each spring the exercise's force (one
+// square root, one division), added to one end and taken from the other; gravity; symplectic
+// Euler. One thread; no grid stencil, no blocks, no passes fused, no copies, no guard. The
+// kernels are inlined (`flatten`), as in the engine's own loops. Its sums are the readable
+// path's, in its order: the same bits as the reference, which the row's note shows.
+
+struct PlainCloth {
+  std::vector<double> x[3], v[3], f[3];  // x[c][i]: coordinate c of particle i
+  std::vector<double> m, inv_m;
+  std::vector<Index> i, j;  // spring k joins particles i[k] and j[k]
+  std::vector<double> ks, kd, l0;
+  Vec3 g = Vec3::Zero();
+  std::vector<double> f1[3];  // each spring's force on its end i, a step's
+
+  // The world's particles, its springs and its gravity; any other force effect is an error.
+  explicit PlainCloth(const World& w) {
+    const Particles& p = w.particles;
+    for (int c = 0; c < 3; ++c) {
+      x[c].assign(p.x.row(c).begin(), p.x.row(c).end());
+      v[c].assign(p.v.row(c).begin(), p.v.row(c).end());
+      f[c].assign(p.x.cols(), 0.0);
+    }
+    m.assign(p.m.begin(), p.m.end());
+    inv_m.assign(p.inv_m.begin(), p.inv_m.end());
+    int gravities = 0;
+    for (const auto& effect : w.force_effects) {
+      if (const auto* s = dynamic_cast<const SpringDampers*>(effect.get())) {
+        if (gravities > 0) throw std::logic_error("bench speed: plain: springs after gravity");
+        const SpringSet& set = s->springs();
+        for (size_t k = 0; k < set.size(); ++k) {
+          i.push_back(set.i(k));
+          j.push_back(set.j(k));
+          ks.push_back(set.ks(k));
+          kd.push_back(set.kd(k));
+          l0.push_back(set.l0(k));
+        }
+      } else if (const auto* gravity = dynamic_cast<const UniformGravity*>(effect.get())) {
+        g = gravity->g();
+        ++gravities;
+      } else {
+        throw std::logic_error("bench speed: plain: a force effect other than springs and gravity");
+      }
+    }
+    if (gravities != 1) throw std::logic_error("bench speed: plain: expected one [gravity]");
+  }
+
+  Matrix3X positions() const { return rows(x); }
+  Matrix3X velocities() const { return rows(v); }
+
+  void step(double dt) {
+    const size_t n = m.size(), springs = i.size();
+    for (int c = 0; c < 3; ++c)
+      std::fill(f[c].begin(), f[c].end(), 0.0);
+    f1[0].resize(springs);
+    f1[1].resize(springs);
+    f1[2].resize(springs);
+    spring_forces(springs, i.data(), j.data(), x[0].data(), x[1].data(), x[2].data(), v[0].data(),
+                  v[1].data(), v[2].data(), ks.data(), kd.data(), l0.data(), f1[0].data(),
+                  f1[1].data(), f1[2].data());
+    for (size_t k = 0; k < springs; ++k) {
+      const auto a = static_cast<size_t>(i[k]), b = static_cast<size_t>(j[k]);
+      for (int c = 0; c < 3; ++c) {
+        f[c][a] += f1[c][k];  // f2 = -f1
+        f[c][b] -= f1[c][k];
+      }
+    }
+    add_gravity(n, m.data(), g, f[0].data(), f[1].data(), f[2].data());
+    move(n, dt, inv_m.data(), f[0].data(), f[1].data(), f[2].data(), x[0].data(), x[1].data(),
+         x[2].data(), v[0].data(), v[1].data(), v[2].data());
+  }
+
+ private:
+  // The stages, each a loop of its own over arrays that do not overlap, the kernels inlined, so
+  // that the compiler takes several springs or particles an instruction where it can: every
+  // spring's force (the ends' coordinates gathered by index), gravity, the move. Adding the
+  // springs' forces to their ends stays one spring at a time: two springs may share an end.
+  [[gnu::flatten, gnu::noinline]] static void spring_forces(
+      size_t count, const Index* __restrict i, const Index* __restrict j,
+      const double* __restrict x, const double* __restrict y, const double* __restrict z,
+      const double* __restrict vx, const double* __restrict vy, const double* __restrict vz,
+      const double* __restrict ks, const double* __restrict kd, const double* __restrict l0,
+      double* __restrict fx, double* __restrict fy, double* __restrict fz) {
+    for (size_t k = 0; k < count; ++k) {
+      const Index a = i[k], b = j[k];
+      const Vec3 f1 = spring_damper_force(Vec3(x[a], y[a], z[a]), Vec3(x[b], y[b], z[b]),
+                                          Vec3(vx[a], vy[a], vz[a]), Vec3(vx[b], vy[b], vz[b]),
+                                          ks[k], kd[k], l0[k]);
+      fx[k] = f1.x();
+      fy[k] = f1.y();
+      fz[k] = f1.z();
+    }
+  }
+  [[gnu::flatten, gnu::noinline]] static void add_gravity(size_t n, const double* __restrict m,
+                                                          const Vec3& g, double* __restrict fx,
+                                                          double* __restrict fy,
+                                                          double* __restrict fz) {
+    const Vec3 field = g;  // a copy: the stores to f cannot change it, and the loop vectorises
+    for (size_t p = 0; p < n; ++p) {
+      const Vec3 fg = gravity_force(m[p], field);
+      fx[p] += fg.x();
+      fy[p] += fg.y();
+      fz[p] += fg.z();
+    }
+  }
+  [[gnu::flatten, gnu::noinline]] static void move(
+      size_t n, double dt, const double* __restrict inv_m, const double* __restrict fx,
+      const double* __restrict fy, const double* __restrict fz, double* __restrict x,
+      double* __restrict y, double* __restrict z, double* __restrict vx, double* __restrict vy,
+      double* __restrict vz) {
+    for (size_t p = 0; p < n; ++p) {
+      PointState next =  // not const: GCC 12 does not split a const aggregate
+          symplectic_euler_step(Vec3(x[p], y[p], z[p]), Vec3(vx[p], vy[p], vz[p]),
+                                Vec3(fx[p], fy[p], fz[p]), inv_m[p], dt);
+      x[p] = next.r.x();
+      y[p] = next.r.y();
+      z[p] = next.r.z();
+      vx[p] = next.v.x();
+      vy[p] = next.v.y();
+      vz[p] = next.v.z();
+    }
+  }
+
+  static Vec3 at(const std::vector<double> (&a)[3], Index p) {
+    const auto q = static_cast<size_t>(p);
+    return Vec3(a[0][q], a[1][q], a[2][q]);
+  }
+  static Matrix3X rows(const std::vector<double> (&a)[3]) {
+    Matrix3X out(3, static_cast<Index>(a[0].size()));
+    for (Index p = 0; p < out.cols(); ++p)
+      out.col(p) = at(a, p);
+    return out;
+  }
+};
+
 // --- The variants --------------------------------------------------------------------------
 
 bool wanted(const SpeedOptions& opt, const std::string& variant) {
@@ -542,6 +684,29 @@ void measure_size(int n, int all_cores, const SpeedOptions& opt, std::vector<Mea
                                         gap_x, gap_v));
     }
   }
+  std::unique_ptr<PlainCloth> plain;
+  if (wanted(opt, "plain")) {
+    Scene scene = parse_scene(cloth_scene(n, 1, true, ""), "<bench>");
+    plain = std::make_unique<PlainCloth>(scene.world);
+    // The same physics, bit for bit, which the note shows: a copy stepped by the plain loops
+    // against the engine on the same start.
+    PlainCloth check(scene.world);
+    for (int k = 0; k < 20; ++k) {
+      check.step(scene.dt);
+      scene.world.step(scene.dt);
+    }
+    const double gap_x = (check.positions() - scene.world.particles.x).cwiseAbs().maxCoeff();
+    const double gap_v = (check.velocities() - scene.world.particles.v).cwiseAbs().maxCoeff();
+    const double dt = scene.dt;
+    PlainCloth& loops = *plain;
+    contenders.push_back(
+        {"plain", 1, static_cast<long>(loops.i.size()), [&loops, dt] { loops.step(dt); }, {}});
+    notes.push_back(gap_x == 0.0 && gap_v == 0.0
+                        ? std::string("the same bits as reference after 20 steps")
+                        : fmt::format("differs from reference after 20 steps: x by {:.1e} m, "
+                                      "v by {:.1e} m/s",
+                                      gap_x, gap_v));
+  }
   KernelRun kernel;
   if (wanted(opt, "kernel")) {
     // No bending springs: the kernel row needs only lessons 01 and 02's exercises, so a student
@@ -599,6 +764,17 @@ void measure_size(int n, int all_cores, const SpeedOptions& opt, std::vector<Mea
         rows[k].note =
             fmt::format("{} / {} {:.2f}; {}", rows[k].variant, twin,
                         rows[k].ns_per_spring_step / rows[r].ns_per_spring_step, rows[k].note);
+      }
+    }
+  }
+  // The engine's one-thread step over the plain loops', both measured in this run.
+  for (size_t k = first_row; k < rows.size(); ++k) {
+    if (rows[k].variant != "plain") continue;
+    for (size_t r = first_row; r < rows.size(); ++r) {
+      if (rows[r].variant == "reference" && rows[r].threads == 1) {
+        rows[k].note =
+            fmt::format("reference / plain {:.2f}; {}",
+                        rows[r].ns_per_spring_step / rows[k].ns_per_spring_step, rows[k].note);
       }
     }
   }
@@ -817,9 +993,9 @@ void add_bench_speed_command(CLI::App& bench) {
   CLI::Option* variants =
       speed->add_option("--variants", o.variants, "Variants to measure (default: all)")
           ->delimiter(',')
-          ->check(CLI::IsMember({"reference", "float", "readable", "naive", "bare", "kernel",
-                                 "+aerodynamics", "+aerodynamics+ground", "float+aerodynamics",
-                                 "implicit", "student"}));
+          ->check(CLI::IsMember({"reference", "float", "readable", "naive", "bare", "plain",
+                                 "kernel", "+aerodynamics", "+aerodynamics+ground",
+                                 "float+aerodynamics", "implicit", "student"}));
   speed
       ->add_flag("--float", o.single,
                  "The float rows (the step in single precision, [engine] precision = \"float\") "

@@ -1,7 +1,8 @@
 # `clothlab bench speed --quick --csv F`: the CSV has the documented header and every row's
-# numbers are positive and finite; every variant is there, and the bare loop agrees with the
-# reference bit for bit. It never asserts a speed: that would fail on a busy machine.
+# numbers are positive and finite; every variant is there, and the bare and plain loops agree
+# with the reference bit for bit. It never asserts a speed: that would fail on a busy machine.
 cmake_policy(SET CMP0057 NEW)  # if(... IN_LIST ...)
+cmake_policy(SET CMP0007 NEW)  # a list keeps its empty elements (bare's ratio below)
 file(REMOVE_RECURSE ${WORK})
 file(MAKE_DIRECTORY ${WORK})
 execute_process(COMMAND ${CLOTHLAB} bench speed --quick --csv speed.csv
@@ -19,29 +20,35 @@ foreach(line ${lines})
   list(GET fields 0 variant)
   list(APPEND variants ${variant})
 endforeach()
-foreach(variant reference float readable naive bare kernel +aerodynamics +aerodynamics+ground
+foreach(variant reference float readable naive bare plain kernel +aerodynamics +aerodynamics+ground
         float+aerodynamics implicit)
   if(NOT variant IN_LIST variants)
     message(FATAL_ERROR "no '${variant}' row in speed.csv:\n${out}")
   endif()
 endforeach()
 # The bare loop (the engine's kernels on a state kept in the fast layout, no copies, no guard)
-# computes the reference's physics bit for bit, at both sizes, on 1 thread and on every core.
-string(REGEX MATCHALL "  bare +[0-9]+ +[^\n]*" bare_rows "${out}")
-string(REGEX MATCHALL "  bare +1 +" bare_rows_1 "${out}")
-list(LENGTH bare_rows_1 bare_count_1)
-if(NOT bare_count_1 EQUAL 2)
-  message(FATAL_ERROR "expected a 1-thread bare row per size, found ${bare_count_1}:\n${out}")
-endif()
-foreach(row ${bare_rows})
-  if(NOT row MATCHES "the same bits as reference after 20 steps")
-    message(FATAL_ERROR "the bare loop does not compute the reference's physics:\n  ${row}")
+# and the plain loops (a list of springs, arrays of x, y and z, a loop a stage) compute the
+# reference's physics bit for bit, at both sizes; bare on 1 thread and on every core, plain on
+# one, set against the reference's step of the same run.
+# (A row's "; " would cut it in two as a CMake list: a comma stands for it.)
+string(REPLACE ";" "," out_commas "${out}")
+foreach(loop "bare;" "plain;reference / plain [0-9.]+, ")
+  list(GET loop 0 name)
+  list(GET loop 1 ratio)
+  string(REGEX MATCHALL "  ${name} +[0-9]+ +[^\n]*" rows "${out_commas}")
+  string(REGEX MATCHALL "  ${name} +1 +" rows_1 "${out_commas}")
+  list(LENGTH rows_1 count_1)
+  if(NOT count_1 EQUAL 2)
+    message(FATAL_ERROR "expected a 1-thread ${name} row per size, found ${count_1}:\n${out}")
   endif()
+  foreach(row ${rows})
+    if(NOT row MATCHES "${ratio}the same bits as reference after 20 steps")
+      message(FATAL_ERROR "the ${name} loop does not compute the reference's physics:\n  ${row}")
+    endif()
+  endforeach()
 endforeach()
 # Each float row is set against its double twin of the same run and says how far single
 # precision took the cloth from the double run: a small drift, not another physics.
-# (A row's "; " would cut it in two as a CMake list: a comma stands for it.)
-string(REPLACE ";" "," out_commas "${out}")
 foreach(pair "float;reference" "float\\+aerodynamics;\\+aerodynamics")
   list(GET pair 0 single)
   list(GET pair 1 twin)

@@ -668,10 +668,10 @@ fps = 100
       "<moving>:8:12: the cloth's particle 0 starts at velocity (0, 0, -1e+39) m/s, beyond what "
       "a 32-bit float holds (3.40282e+38), which velocities.npy keeps"));
   // Within a float's range (the cloth's far corner, 1e30 m): no note.
-  CHECK_FALSE(clothlab::parse_scene(far.substr(0, far.find("[[particle]]")) +
-                                        far.substr(far.find("[cloth]")),
-                                    "<near>")
-                  .position_beyond_float);
+  CHECK_FALSE(
+      clothlab::parse_scene(
+          far.substr(0, far.find("[[particle]]")) + far.substr(far.find("[cloth]")), "<near>")
+          .position_beyond_float);
 }
 
 namespace {
