@@ -45,8 +45,9 @@ void check_particle_mass(SceneTable& t, std::string_view key, double m, const st
   }
 }
 
-// The largest number a 32-bit float holds (3.4e38): the page and the .npy files keep floats.
-constexpr double kFloatFileMax = std::numeric_limits<float>::max();
+// The largest number a 32-bit float holds (3.4e38): the page and the .npy files keep floats, and
+// the float room computes in them.
+constexpr double kFloatMax = std::numeric_limits<float>::max();
 
 // Notes in `scene` the first start past what a float holds, at `key`: a position (x [m]) or a
 // velocity (v [m/s]) that the guard's widened bounds let through. A run that would write it to
@@ -55,18 +56,18 @@ void note_beyond_float(const SceneTable& t, std::string_view key, Scene& scene, 
                        bool position, std::string_view what) {
   std::optional<SceneWarning>& note =
       position ? scene.position_beyond_float : scene.velocity_beyond_float;
-  if (note || (x.array().abs() <= kFloatFileMax).all()) return;
+  if (note || (x.array().abs() <= kFloatMax).all()) return;
   note = t.at(key, position ? fmt::format("{} starts at ({}, {}, {}) m, beyond what a 32-bit float "
                                           "holds ({:.6g}), which the page and positions.npy keep; "
                                           "expected |x|, |y|, |z| <= {:.6g} m, or a run that "
                                           "writes the CSV files alone (--no-html, format = "
                                           "\"csv\")",
-                                          what, x.x(), x.y(), x.z(), kFloatFileMax, kFloatFileMax)
+                                          what, x.x(), x.y(), x.z(), kFloatMax, kFloatMax)
                             : fmt::format("{} starts at velocity ({}, {}, {}) m/s, beyond what a "
                                           "32-bit float holds ({:.6g}), which velocities.npy "
                                           "keeps; expected each component within {:.6g} m/s, or "
                                           "velocities in velocities.csv (format = \"csv\")",
-                                          what, x.x(), x.y(), x.z(), kFloatFileMax, kFloatFileMax));
+                                          what, x.x(), x.y(), x.z(), kFloatMax, kFloatMax));
 }
 
 // The guard stops a run at its first step if a particle starts beyond its bounds, so such a scene
@@ -1012,7 +1013,6 @@ void read_guard(SceneTable& t, Scene& scene) {
 // the scene (ks = 1e39 would be inf, and the first step NaN), a particle's 1/m (the move's) or its
 // start. A step in float of any of them could only blow up.
 std::string beyond_float(const Scene& scene) {
-  constexpr double kFloatMax = std::numeric_limits<float>::max();
   for (const TunableNumber& number : scene.tunables) {
     if (std::abs(number.value) > kFloatMax)
       return fmt::format("{} = {:g}{}{}", number.path, number.value, number.unit.empty() ? "" : " ",
