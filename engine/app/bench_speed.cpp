@@ -362,9 +362,12 @@ KernelRun kernel_run(const World& world) {
 
 struct BareCloth {
   const World* world = nullptr;
-  fast::Copies state;  // x, v and f, rows spaced as on the engine's fast path
-  fast::Copies next;   // x and v after the step: each block of particles moves here while
-                       // later blocks and other threads may still read its x and v in `state`
+  // x, v and f, laid out as on the engine's fast path (a run of steps' two copies): `state`,
+  // and `next`, x and v after the step: each block of particles moves there while later blocks
+  // and other threads may still read its x and v in `state`.
+  fast::ResidentOf<double> copies;
+  fast::Copies* state_ = &copies.a;
+  fast::Copies* next_ = &copies.b;
   std::vector<std::unique_ptr<fast::FastForce>> forces;  // the fast form of each force effect
   std::unique_ptr<ThreadTeam> team;                      // null on 1 thread
 
@@ -377,15 +380,14 @@ struct BareCloth {
       }
     }
     const Index n = w.particles.size();
-    state.resize(n);
-    next.resize(n);
-    state.x.leftCols(n) = w.particles.x;
-    state.v.leftCols(n) = w.particles.v;
+    copies.resize(n);
+    state_->x.leftCols(n) = w.particles.x;
+    state_->v.leftCols(n) = w.particles.v;
     if (threads > 1) team = std::make_unique<ThreadTeam>(threads);
   }
 
-  Matrix3X positions() const { return state.x.leftCols(world->particles.size()); }
-  Matrix3X velocities() const { return state.v.leftCols(world->particles.size()); }
+  Matrix3X positions() const { return state_->x.leftCols(world->particles.size()); }
+  Matrix3X velocities() const { return state_->v.leftCols(world->particles.size()); }
 
   // As on the engine's fast path, each thread owns a contiguous range of particles and takes it
   // a block at a time (fast::kPassBlock): it sums the block's forces, then moves it into `next`.
@@ -393,10 +395,9 @@ struct BareCloth {
     const Index block = fast::kPassBlock;
     for_ranges(team.get(), world->particles.size(), [&](Index begin, Index end) {
       for (Index b0 = begin; b0 < end; b0 += block)
-        step_range(b0, std::min(b0 + block, end), dt, next.x.data(), next.v.data());
+        step_range(b0, std::min(b0 + block, end), dt, next_->x.data(), next_->v.data());
     });
-    state.x.swap(next.x);
-    state.v.swap(next.v);
+    std::swap(state_, next_);
   }
 
   // `flatten`: the exercise kernels inlined here, as in the engine's own loops.
@@ -404,6 +405,7 @@ struct BareCloth {
   [[gnu::flatten, gnu::noinline]] void step_range(Index begin, Index end, double dt, double* x_out,
                                                   double* v_out) {
     const Particles& p = world->particles;
+    fast::Copies& state = *state_;
     state.f.middleCols(begin, end - begin).setZero();
     for (const auto& force : forces)
       force->add(p, state.x, state.v, state.f, begin, end);

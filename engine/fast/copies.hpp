@@ -5,12 +5,17 @@
 // of every particle, then the y components, then the z components, each row contiguous. Column
 // i is still particle i (s.col(i) is a Vec3 expression), but a loop over particles reads each
 // component in memory order, which lets the compiler take four or eight particles at once. The
-// copies have a few more columns than there are particles (Copies::resize says why), so row c of
+// copies have a few more columns than there are particles (padded_columns says why), so row c of
 // s starts at s.data() + c * s.cols(): use s.cols() as the stride, never the number of particles.
 // The float room (float_room.hpp) keeps the same copies in float: SoA3f, CopiesOf<float>.
 #pragma once
 
+#include <array>
 #include <cmath>
+#include <cstddef>
+#include <cstdlib>
+#include <memory>
+#include <new>
 #include <type_traits>
 
 #include "clothlab/core/types.hpp"
@@ -21,39 +26,148 @@
 
 namespace clothlab::fast {
 
+// A structure of arrays that owns its storage (XPBD's and local/global's positions).
 template <class Scalar>
-using SoA3Of = Eigen::Matrix<Scalar, 3, Eigen::Dynamic, Eigen::RowMajor>;
+using SoA3MatrixOf = Eigen::Matrix<Scalar, 3, Eigen::Dynamic, Eigen::RowMajor>;
+using SoA3Matrix = SoA3MatrixOf<double>;
+
+// The copies the force effects read and write: a view of storage laid out by the engine room
+// (CopiesOf, ResidentOf). Row c starts at data() + c * cols(), as in an SoA3MatrixOf.
+template <class Scalar>
+using SoA3Of = Eigen::Map<SoA3MatrixOf<Scalar>>;
 using SoA3 = SoA3Of<double>;
 using SoA3f = SoA3Of<float>;
 
-// The copies of positions, velocities and forces, kept by the fast engine between evaluations.
+// Columns for n particles in a structure of arrays whose rows start `lines` cache lines apart,
+// modulo 4 KiB. Rows n apart, for a cloth of 2^k particles, would start at the same place of a
+// 4 KiB page, and the processor's first-level cache keeps only a few lines with the same such
+// place: a spring's dozen inputs, all read at once, would evict each other.
+template <class Scalar>
+Index padded_columns(Index n, Index lines) {
+  const Index period = 4096 / sizeof(Scalar), shift = lines * 64 / sizeof(Scalar);
+  return n + ((shift - n) % period + period) % period;
+}
+
+// One allocation of the engine room's own, its start on a 4 KiB page, holding the arrays of one
+// or more copies, each array's first row at a chosen cache line of a page.
+//
+// Why not Eigen's own storage: the fast path's files are compiled with Eigen's vector code off
+// (EIGEN_DONT_VECTORIZE, sources.cmake), and then Eigen aligns what it allocates to 16 bytes
+// only. The spring loops read and write the copies 8 doubles (16 floats) an instruction, 64
+// bytes: an array 16 bytes past a cache line makes each of those accesses touch two lines.
+// SPEED.md measured the double step 9 % slower so (*The copies on cache lines*).
+template <class Scalar>
+class SoA3Pages {
+ public:
+  // Room for arrays of 3 rows of columns[k] each, array k's first row at cache line
+  // start_line[k] (0 to 63) of a 4 KiB page; returns where each starts. The allocation is kept
+  // if it has room; what the arrays held is not.
+  template <size_t K>
+  std::array<Scalar*, K> lay_out(const std::array<Index, K>& columns,
+                                 const std::array<int, K>& start_line) {
+    std::array<size_t, K> offset{};  // in bytes from the allocation's start
+    size_t end = 0;
+    for (size_t k = 0; k < K; ++k) {
+      const size_t place = static_cast<size_t>(start_line[k] % 64) * 64;
+      const size_t page = end / 4096 * 4096;
+      offset[k] = page + place >= end ? page + place : page + 4096 + place;
+      end = offset[k] + 3 * static_cast<size_t>(columns[k]) * sizeof(Scalar);
+    }
+    if (end > bytes_) {
+      const size_t bytes = (end + 4095) / 4096 * 4096;
+      data_.reset(static_cast<std::byte*>(std::aligned_alloc(4096, bytes)));
+      if (!data_) throw std::bad_alloc();
+      bytes_ = bytes;
+    }
+    std::array<Scalar*, K> at{};
+    for (size_t k = 0; k < K; ++k)
+      at[k] = reinterpret_cast<Scalar*>(data_.get() + offset[k]);
+    return at;
+  }
+
+ private:
+  struct Free {
+    void operator()(std::byte* p) const { std::free(p); }
+  };
+  std::unique_ptr<std::byte, Free> data_;
+  size_t bytes_ = 0;
+};
+
+// Where a copy's x, v and f start in a 4 KiB page, in cache lines (SoA3Pages::lay_out). With the
+// rows' spacing (kRowSpacing), the 18 rows of a run of steps' two copies (ResidentOf) each start
+// at a line of their own, at least 2 lines from any other: no two of a spring's inputs or
+// outputs share a place in the page by the layout's doing.
+struct CopyPlaces {
+  int x, v, f;
+};
+inline constexpr Index kRowSpacing[3] = {21, 7, 49};  // lines between the rows of x, v and f
+inline constexpr CopyPlaces kFirstCopy{0, 38, 23}, kSecondCopy{5, 3, 28};
+
+// The copies of positions, velocities and forces, kept by the fast engine between evaluations:
+// views of storage laid out by the engine room (SoA3Pages). Not copyable: a copy's views would
+// point into the original's storage.
 template <class Scalar>
 struct CopiesOf {
-  SoA3Of<Scalar> x, v, f;
+  SoA3Of<Scalar> x{nullptr, 3, 0}, v{nullptr, 3, 0}, f{nullptr, 3, 0};
 
-  // Room for n particles in x, v and f, each with rows spaced its own way: the columns past n
-  // are padding. Rows n apart, for a cloth of 2^k particles, would start at the same place of a
-  // 4 KiB page, and the processor's first-level cache keeps only 8 lines with the same such
-  // place: a spring's dozen inputs, all read at once, would evict each other.
+  CopiesOf() = default;
+  CopiesOf(const CopiesOf&) = delete;
+  CopiesOf& operator=(const CopiesOf&) = delete;
+
+  // Room for n particles in x, v and f, in storage of its own; the columns past n are padding.
+  // What they held is kept only if n is unchanged.
   void resize(Index n) {
-    x.resize(3, padded(n, 21));
-    v.resize(3, padded(n, 7));
-    f.resize(3, padded(n, 49));
+    if (n == n_) return;
+    const auto at = pages_.lay_out(columns(n), starts(kFirstCopy));
+    bind(n, at[0], at[1], at[2]);
   }
 
-  // Columns for n particles in a SoA3 whose rows start `lines` cache lines apart, modulo 4 KiB.
-  static Index padded(Index n, Index lines) {
-    const Index period = 4096 / sizeof(Scalar), shift = lines * 64 / sizeof(Scalar);
-    return n + ((shift - n) % period + period) % period;
+  // The columns of x, v and f for n particles, and their first rows' places.
+  static std::array<Index, 3> columns(Index n) {
+    return {padded(n, kRowSpacing[0]), padded(n, kRowSpacing[1]), padded(n, kRowSpacing[2])};
   }
+  static std::array<int, 3> starts(const CopyPlaces& p) { return {p.x, p.v, p.f}; }
+
+  // x, v and f as views of arrays laid out elsewhere (ResidentOf), columns(n) each.
+  void bind(Index n, Scalar* xs, Scalar* vs, Scalar* fs) {
+    const auto c = columns(n);
+    new (&x) SoA3Of<Scalar>(xs, 3, c[0]);
+    new (&v) SoA3Of<Scalar>(vs, 3, c[1]);
+    new (&f) SoA3Of<Scalar>(fs, 3, c[2]);
+    n_ = n;
+  }
+
+  // Columns for n particles in an array whose rows start `lines` cache lines apart, modulo 4 KiB.
+  static Index padded(Index n, Index lines) { return padded_columns<Scalar>(n, lines); }
+
+ private:
+  SoA3Pages<Scalar> pages_;
+  Index n_ = -1;
 };
 using Copies = CopiesOf<double>;
 
 // The two copies of the state a run of steps takes turns with (resident.hpp): the one a step
-// reads, and the one its move writes.
+// reads, and the one its move writes, in one allocation.
 template <class Scalar>
 struct ResidentOf {
   CopiesOf<Scalar> a, b;
+
+  // Room for n particles in both; what they held is kept only if n is unchanged.
+  void resize(Index n) {
+    if (n == n_) return;
+    const auto c = CopiesOf<Scalar>::columns(n);
+    const auto sa = CopiesOf<Scalar>::starts(kFirstCopy),
+               sb = CopiesOf<Scalar>::starts(kSecondCopy);
+    const auto at = pages_.lay_out(std::array<Index, 6>{c[0], c[1], c[2], c[0], c[1], c[2]},
+                                   std::array<int, 6>{sa[0], sa[1], sa[2], sb[0], sb[1], sb[2]});
+    a.bind(n, at[0], at[1], at[2]);
+    b.bind(n, at[3], at[4], at[5]);
+    n_ = n;
+  }
+
+ private:
+  SoA3Pages<Scalar> pages_;
+  Index n_ = -1;
 };
 
 // Particles [begin, end) of a (the engine's layout: x, y, z of particle i at a[3 i], a[3 i + 1],

@@ -204,8 +204,8 @@ class FastEngine final : public Backend {
   std::vector<Contact> contacts_;
   std::vector<StepStart*> starts_;  // theirs (PassChecks::starts)
   Copies copies_;
-  ResidentOf<double> resident_;  // steps' two copies of the state
-  SoA3 xpbd_x_, xpbd_old_;       // x and x_old in the fast layout, for XPBD's projections
+  ResidentOf<double> resident_;   // steps' two copies of the state
+  SoA3Matrix xpbd_x_, xpbd_old_;  // x and x_old in the fast layout, for XPBD's projections
   // VBD: the constants of every spring at every vertex, in the sweep's order (vbd.cpp).
   struct VbdSpring {
     Index other;        // the spring's other end

@@ -36,7 +36,7 @@ struct LocalGlobalRoom {
   // Each unknown's springs, in the order of the list: entry 2 s for a spring whose end i it is,
   // 2 s + 1 for end j; the row r's run from start[r] to start[r + 1].
   std::vector<Index> start, incident;
-  SoA3 x;                 // [m] the positions in the fast layout
+  SoA3Matrix x;           // [m] the positions in the fast layout
   std::vector<double> d;  // [m] every spring's d: all x, then all y, then all z
   Eigen::Matrix<double, Eigen::Dynamic, 3> b, solution;
 };

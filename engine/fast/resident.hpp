@@ -39,8 +39,7 @@ BackendSteps resident_steps(World& world, double dt, long count, ResidentOf<S>& 
                             Index chunk, Add add, Move move) {
   Particles& p = world.particles;
   const Index n = p.size();
-  r.a.resize(n);
-  r.b.resize(n);
+  r.resize(n);
   p.f.resize(3, n);
   // The world's time as the steps reach it, advanced as World::step advances world.t (the same
   // additions, so the same bits); world.t itself moves after the job, with the steps taken.

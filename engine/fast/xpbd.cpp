@@ -77,8 +77,8 @@ template <class Kernel>
 // olds) for the passes, x copied back after them.
 template <class Kernel>
 void colour_passes(World& world, const XpbdConstraints& cs, const Matrix3X& x_old, double h,
-                   int iterations, bool keep_lambda, std::vector<double>& lambda, SoA3& xs,
-                   SoA3& olds, Index split, Kernel kernel) {
+                   int iterations, bool keep_lambda, std::vector<double>& lambda, SoA3Matrix& xs,
+                   SoA3Matrix& olds, Index split, Kernel kernel) {
   Particles& p = world.particles;
   const Index n = p.size();
   xs.resize(3, Copies::padded(n, 21));

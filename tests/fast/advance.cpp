@@ -3,10 +3,13 @@
 // the state, the forces, the time, the counts and the guard's errors.
 #include <doctest/doctest.h>
 
+#include <algorithm>
+#include <cstdint>
 #include <string>
 #include <vector>
 
 #include "clothlab/core/guard.hpp"
+#include "fast/copies.hpp"
 #include "fast_util.hpp"
 
 using clothlab::Index;
@@ -274,4 +277,65 @@ TEST_CASE("advance: in float, the steps read the masses the particles have now")
     CAPTURE(off);
     CHECK(off < 1e-5);
   }
+}
+
+namespace {
+
+// Every row of `copies` (x, v and f of each) starts on a cache line; the rows lie apart, each
+// within its array's storage; and no two of them start within `min_lines` lines of the same
+// place in a 4 KiB page.
+template <class S>
+void check_rows(const std::vector<const clothlab::fast::CopiesOf<S>*>& copies, Index n,
+                int min_lines) {
+  struct Row {
+    std::uintptr_t begin, end;
+  };
+  std::vector<Row> rows;
+  for (const auto* c : copies) {
+    for (const auto* a : {&c->x, &c->v, &c->f}) {
+      REQUIRE(a->cols() >= n);
+      for (Index r = 0; r < 3; ++r) {
+        const auto begin = reinterpret_cast<std::uintptr_t>(a->data() + r * a->cols());
+        rows.push_back({begin, begin + static_cast<std::uintptr_t>(n) * sizeof(S)});
+      }
+    }
+  }
+  for (size_t i = 0; i < rows.size(); ++i) {
+    CAPTURE(i);
+    CHECK(rows[i].begin % 64 == 0);
+    for (size_t j = 0; j < i; ++j) {
+      CAPTURE(j);
+      CHECK((rows[i].end <= rows[j].begin || rows[j].end <= rows[i].begin));
+      const long a = static_cast<long>(rows[i].begin % 4096 / 64);
+      const long b = static_cast<long>(rows[j].begin % 4096 / 64);
+      CHECK(std::min((a - b + 64) % 64, (b - a + 64) % 64) >= min_lines);
+    }
+  }
+}
+
+template <class S>
+void check_layouts() {
+  for (const Index n : {Index{1}, Index{100}, Index{4096}, Index{16384}, Index{70001}}) {
+    CAPTURE(n);
+    clothlab::fast::CopiesOf<S> one;
+    one.resize(n);
+    check_rows<S>({&one}, n, 2);
+    clothlab::fast::ResidentOf<S> two;
+    two.resize(n);
+    check_rows<S>({&two.a, &two.b}, n, 2);
+    // Smaller, then larger than before: laid out again, with the same guarantees.
+    two.resize(n / 2 + 1);
+    check_rows<S>({&two.a, &two.b}, n / 2 + 1, 2);
+    two.resize(2 * n);
+    check_rows<S>({&two.a, &two.b}, 2 * n, 2);
+  }
+}
+
+}  // namespace
+
+// The spring loops read and write the copies 64 bytes an instruction: a row that does not start
+// on a cache line makes each access touch two (SPEED.md, *The copies on cache lines*).
+TEST_CASE("copies: every row on a cache line, at a place in the page of its own") {
+  check_layouts<double>();
+  check_layouts<float>();
 }
