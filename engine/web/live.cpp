@@ -15,6 +15,7 @@
 #include <algorithm>
 #include <cmath>
 #include <exception>
+#include <limits>
 #include <map>
 #include <memory>
 #include <optional>
@@ -209,6 +210,17 @@ extern "C" {
 EMSCRIPTEN_KEEPALIVE int clothlab_load(const char* text, const char* name) {
   return guarded([&] {
     clothlab::Scene scene = clothlab::parse_scene(text, name);
+    // The page draws the positions as 32-bit floats: a start past a float's range, which a
+    // widened [guard] lets through, would be drawn at infinity. Refused at the key that set it,
+    // as clothlab run refuses it for a page (io/run.cpp).
+    if (const std::optional<clothlab::SceneWarning>& far = scene.position_beyond_float) {
+      const std::string& said = far->message;
+      throw clothlab::SceneError(
+          far->source, far->line, far->column,
+          fmt::format("{}; expected |x|, |y|, |z| <= {:.6g} m: the page draws positions as 32-bit "
+                      "floats",
+                      said.substr(0, said.find("; expected")), std::numeric_limits<float>::max()));
+    }
     scene.world.threads = 1;  // one thread in a page
     g_simulation = std::make_unique<Simulation>(std::move(scene));
     const clothlab::Particles& p = g_simulation->world().particles;

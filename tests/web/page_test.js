@@ -191,6 +191,18 @@
           api.particles() === 400 && !ok && /blew up at step/.test(page.message()), page.message());
     }
 
+    // A start past a float's range, which a widened [guard] lets through: the page draws its
+    // positions as 32-bit floats, so it refuses the scene at the key that set it, as clothlab run
+    // refuses it for a page; a start just within the range loads.
+    const farScene = (y) => `[guard]\nmax_position = 1e300\n[[particle]]\nposition = [0, ${y}, 0]\n` +
+      'mass = 1\n[integrator]\ndt = 0.01\nduration = 0.05\n';
+    say('a start past a float\'s range is refused at its key, saying that the page draws in floats',
+        !page.load(farScene('1e39'), 'far.toml') &&
+          /far\.toml:4:12: .*beyond what a 32-bit float holds.*the page draws positions as 32-bit floats/
+            .test(page.message()), page.message());
+    say('a start within a float\'s range loads', page.load(farScene('1e38'), 'near.toml'),
+        page.message());
+
     // A slider changes the motion: the same scene, run twice for 0.6 s, once with the first
     // slider's number five times larger (or 1 if it is 0). (Long enough for lesson 09's jelly
     // cube, whose springs first bend when it lands, after 0.32 s of free fall.)
