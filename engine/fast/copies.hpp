@@ -53,8 +53,9 @@ Index padded_columns(Index n, Index lines) {
 //
 // Why not Eigen's own storage: the project is compiled with Eigen's vector code off
 // (EIGEN_DONT_VECTORIZE, sources.cmake), and then Eigen aligns what it allocates as malloc
-// does, to 16 bytes. The spring loops read and write the copies 8 doubles (16 floats) an instruction, 64
-// bytes: an array 16 bytes past a cache line makes each of those accesses touch two lines.
+// does, to 16 bytes. The spring loops read and write the copies 8 doubles (16 floats) an
+// instruction, 64 bytes: an array 16 bytes past a cache line makes each of those accesses touch
+// two lines.
 // SPEED.md measured the double step about 8 % slower so (*The copies on cache lines*).
 template <class Scalar>
 class SoA3Pages {
