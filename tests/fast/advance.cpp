@@ -281,9 +281,9 @@ TEST_CASE("advance: in float, the steps read the masses the particles have now")
 
 namespace {
 
-// Every row of `copies` (x, v and f of each) starts on a cache line; the rows lie apart, each
-// within its array's storage; and no two of them start within `min_lines` lines of the same
-// place in a 4 KiB page.
+// Every row of `copies` (x, v and f of each) starts on a cache line; no two rows overlap, each
+// taken whole, its padding included; and no two of them start within `min_lines` lines of the
+// same place in a 4 KiB page.
 template <class S>
 void check_rows(const std::vector<const clothlab::fast::CopiesOf<S>*>& copies, Index n,
                 int min_lines) {
@@ -296,7 +296,7 @@ void check_rows(const std::vector<const clothlab::fast::CopiesOf<S>*>& copies, I
       REQUIRE(a->cols() >= n);
       for (Index r = 0; r < 3; ++r) {
         const auto begin = reinterpret_cast<std::uintptr_t>(a->data() + r * a->cols());
-        rows.push_back({begin, begin + static_cast<std::uintptr_t>(n) * sizeof(S)});
+        rows.push_back({begin, begin + static_cast<std::uintptr_t>(a->cols()) * sizeof(S)});
       }
     }
   }
