@@ -98,11 +98,8 @@ class SoA3Pages {
 // rows' spacing (kRowSpacing), the 18 rows of a run of steps' two copies (ResidentOf) each start
 // at a line of their own, at least 2 lines from any other: no two of a spring's inputs or
 // outputs share a place in the page by the layout's doing.
-struct CopyPlaces {
-  int x, v, f;
-};
 inline constexpr Index kRowSpacing[3] = {21, 7, 49};  // lines between the rows of x, v and f
-inline constexpr CopyPlaces kFirstCopy{0, 38, 23}, kSecondCopy{5, 3, 28};
+inline constexpr std::array<int, 3> kFirstCopy{0, 38, 23}, kSecondCopy{5, 3, 28};  // x, v, f
 
 // The copies of positions, velocities and forces, kept by the fast engine between evaluations:
 // views of storage laid out by the engine room (SoA3Pages). Not copyable: a copy's views would
@@ -119,15 +116,15 @@ struct CopiesOf {
   // What they held is kept only if n is unchanged.
   void resize(Index n) {
     if (n == n_) return;
-    const auto at = pages_.lay_out(columns(n), starts(kFirstCopy));
+    const auto at = pages_.lay_out(columns(n), kFirstCopy);
     bind(n, at[0], at[1], at[2]);
   }
 
-  // The columns of x, v and f for n particles, and their first rows' places.
+  // The columns of x, v and f for n particles.
   static std::array<Index, 3> columns(Index n) {
-    return {padded(n, kRowSpacing[0]), padded(n, kRowSpacing[1]), padded(n, kRowSpacing[2])};
+    return {padded_columns<Scalar>(n, kRowSpacing[0]), padded_columns<Scalar>(n, kRowSpacing[1]),
+            padded_columns<Scalar>(n, kRowSpacing[2])};
   }
-  static std::array<int, 3> starts(const CopyPlaces& p) { return {p.x, p.v, p.f}; }
 
   // x, v and f as views of arrays laid out elsewhere (ResidentOf), columns(n) each.
   void bind(Index n, Scalar* xs, Scalar* vs, Scalar* fs) {
@@ -137,9 +134,6 @@ struct CopiesOf {
     new (&f) SoA3Of<Scalar>(fs, 3, c[2]);
     n_ = n;
   }
-
-  // Columns for n particles in an array whose rows start `lines` cache lines apart, modulo 4 KiB.
-  static Index padded(Index n, Index lines) { return padded_columns<Scalar>(n, lines); }
 
  private:
   SoA3Pages<Scalar> pages_;
@@ -157,8 +151,8 @@ struct ResidentOf {
   void resize(Index n) {
     if (n == n_) return;
     const auto c = CopiesOf<Scalar>::columns(n);
-    const auto sa = CopiesOf<Scalar>::starts(kFirstCopy),
-               sb = CopiesOf<Scalar>::starts(kSecondCopy);
+    const auto& sa = kFirstCopy;
+    const auto& sb = kSecondCopy;
     const auto at = pages_.lay_out(std::array<Index, 6>{c[0], c[1], c[2], c[0], c[1], c[2]},
                                    std::array<int, 6>{sa[0], sa[1], sa[2], sb[0], sb[1], sb[2]});
     a.bind(n, at[0], at[1], at[2]);

@@ -116,7 +116,7 @@ bool FastEngine::local_global_iterate(World& world, LocalGlobalSystem& system, i
   Particles& p = world.particles;
   const Index n = p.size(), rows = system.a.rows();
   const size_t ns = system.i.size();
-  room.x.resize(3, Copies::padded(n, 21));
+  room.x.resize(3, padded_columns<double>(n, 21));
   const Index nx = room.x.cols();
   world.for_particles(
       [&](Index begin, Index end) { to_soa(begin, end, p.x.data(), room.x.data(), nx); });

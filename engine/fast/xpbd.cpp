@@ -81,8 +81,8 @@ void colour_passes(World& world, const XpbdConstraints& cs, const Matrix3X& x_ol
                    SoA3Matrix& olds, Index split, Kernel kernel) {
   Particles& p = world.particles;
   const Index n = p.size();
-  xs.resize(3, Copies::padded(n, 21));
-  olds.resize(3, Copies::padded(n, 7));
+  xs.resize(3, padded_columns<double>(n, 21));
+  olds.resize(3, padded_columns<double>(n, 7));
   const Index nx = xs.cols(), no = olds.cols();
   world.for_particles([&](Index begin, Index end) {
     to_soa(begin, end, p.x.data(), xs.data(), nx);
