@@ -13,12 +13,13 @@
 //
 // All the steps are one job of the world's threads: each thread takes its particles through
 // every step, and waits at a barrier between two steps (the next reads the x and v every thread
-// has just written), where one thread also tells each force effect the next step's time
-// (set_time), before a second barrier. The world's time and counts move after the job, by the
-// steps taken.
+// has just written): one barrier a step, the last thread to reach it telling each force effect
+// the next step's time (set_time) before the others go on. The world's time and counts move
+// after the job, by the steps taken.
 #pragma once
 
 #include <atomic>
+#include <functional>
 
 #include "clothlab/core/backend.hpp"
 #include "clothlab/core/threads.hpp"
@@ -45,9 +46,26 @@ BackendSteps resident_steps(World& world, double dt, long count, ResidentOf<S>& 
   // additions, so the same bits); world.t itself moves after the job, with the steps taken.
   double t = world.t;
   for (const auto& effect : world.force_effects)
-    effect->set_time(t);  // the first step's; one thread sets the others' between steps
+    effect->set_time(t);  // the first step's; the last thread to finish a step sets the next's
   std::atomic<bool> start_within = true, end_within = true;
-  std::atomic<long> between = 0, taken = 0;
+  // What happens between two steps, once, on the last thread to finish the first of them, while
+  // the others wait at the barrier (Barrier::wait): whether that step was the last, and if not,
+  // the next step's time told to every effect. `taken` counts the steps every thread has done
+  // (a step that throws, or whose next time does, is not among them); every thread reads `last`
+  // once the barrier lets it go.
+  long taken = 0;
+  bool last = false;
+  const std::function<void()> between_steps = [&] {
+    if (taken + 1 == count || !end_within) {
+      ++taken;
+      last = true;
+      return;
+    }
+    t += dt;
+    for (const auto& effect : world.force_effects)
+      effect->set_time(t);
+    ++taken;
+  };
   const auto steps = [&](Index begin, Index end, const Barrier& barrier) {
     const bool x_within =
         to_soa_within(begin, end, p.x.data(), r.a.x.data(), r.a.x.cols(), world.guard.max_position);
@@ -59,7 +77,7 @@ BackendSteps resident_steps(World& world, double dt, long count, ResidentOf<S>& 
     CopiesOf<S>* now = &r.a;
     CopiesOf<S>* next = &r.b;
     try {
-      for (long k = 1;; ++k) {
+      for (;;) {
         for (Index b0 = begin; b0 < end; b0 += block) {
           const Index b1 = std::min(b0 + block, end);
           now->f.middleCols(b0, b1 - b0).setZero();
@@ -68,19 +86,9 @@ BackendSteps resident_steps(World& world, double dt, long count, ResidentOf<S>& 
             if (!move(c0, std::min(c0 + chunk, b1), *now, *next)) end_within = false;
           }
         }
-        barrier.wait();  // every particle has moved: the next step may read any of them
-        if (k == count || !end_within) {
-          taken = k;
-          break;
-        }
-        // The effects' time for step k + 1, set by whichever thread comes first.
-        long before = k - 1;
-        if (between.compare_exchange_strong(before, k)) {
-          t += dt;
-          for (const auto& effect : world.force_effects)
-            effect->set_time(t);
-        }
-        barrier.wait();
+        // Every particle has moved: the next step may read any of them, at its own time.
+        barrier.wait(between_steps);
+        if (last) break;
         std::swap(now, next);
       }
     } catch (...) {
@@ -107,15 +115,15 @@ BackendSteps resident_steps(World& world, double dt, long count, ResidentOf<S>& 
   try {
     world.for_particles_with_barrier(steps);
   } catch (...) {
-    account(between.load());  // the steps before the one that threw
+    account(taken);  // the steps before the one that threw
     throw;
   }
   if (!start_within) {
     world.guard.check(world, /*before_step=*/true);  // names the particle and throws
     return {};
   }
-  account(taken.load());
-  return {taken.load(), end_within.load()};
+  account(taken);
+  return {taken, end_within.load()};
 }
 
 }  // namespace clothlab::fast

@@ -957,7 +957,9 @@ TEST_CASE("fast path: a thread team runs every job once and passes on what a job
   CHECK(sum == 100 * 6 + 3);
 }
 
-TEST_CASE("fast path: a job's threads meet at sync(), and a throw there leaves none waiting") {
+TEST_CASE(
+    "fast path: a job's threads meet at sync(), last() runs once there, and a throw leaves none "
+    "waiting") {
   for (int size = 1; size <= 4; ++size) {
     CAPTURE(size);
     clothlab::ThreadTeam team(size);
@@ -977,6 +979,28 @@ TEST_CASE("fast path: a job's threads meet at sync(), and a throw there leaves n
     }
     CHECK(stale == 0);
     CHECK(team.runs() == kRounds);  // two meetings a job, no more wakes
+    // sync(last): last() runs once a meeting, on the thread that arrives last (after every
+    // thread's first part), and before any thread leaves: each finds its count moved on.
+    long lasts = 0;
+    std::atomic<long> early{0}, late{0};
+    std::vector<long> parts(static_cast<size_t>(size), 0);
+    const std::function<void()> last = [&] {
+      for (int u = 0; u < size; ++u)
+        late += parts[static_cast<size_t>(u)] != lasts + 1;  // a thread not yet done
+      ++lasts;
+    };
+    for (long round = 0; round < kRounds; ++round) {
+      team.run([&](int t) {
+        for (long meeting = 0; meeting < 3; ++meeting) {
+          ++parts[static_cast<size_t>(t)];
+          team.sync(last);
+          early += lasts != 3 * round + meeting + 1;
+        }
+      });
+    }
+    CHECK(lasts == 3 * kRounds);
+    CHECK(early == 0);
+    CHECK(late == 0);
     // A job that throws on one thread before the barrier, the others waiting there: run()
     // returns and rethrows that error, and the team still works.
     for (int thrower = 0; thrower < size; ++thrower) {
@@ -994,6 +1018,21 @@ TEST_CASE("fast path: a job's threads meet at sync(), and a throw there leaves n
       });
       CHECK(met == size);
     }
+    // last() that throws: the job's error, the others released, the team still works.
+    const std::function<void()> failing = [] { throw std::runtime_error("between the parts"); };
+    std::atomic<int> past{0};
+    CHECK_THROWS_WITH_AS(team.run([&](int) {
+      team.sync(failing);
+      ++past;
+    }),
+                         "between the parts", std::runtime_error);
+    CHECK(past == 0);
+    std::atomic<int> met{0};
+    team.run([&](int) {
+      team.sync(last);
+      ++met;
+    });
+    CHECK(met == size);
   }
 }
 

@@ -91,13 +91,19 @@ void ThreadTeam::job_of(int t) {
   }
 }
 
-void ThreadTeam::sync() {
-  if (size_ == 1) return;
+void ThreadTeam::sync(const std::function<void()>& last) {
+  if (size_ == 1) {
+    if (last) last();
+    return;
+  }
   // The round is read before arriving, and only the last thread to arrive moves it on, so no
   // thread can miss the round it waits for.
   const unsigned round = rounds_.load();
   if (arrived_.fetch_add(1) + 1 == size_) {
     arrived_.store(0);  // before the round moves on: no thread arrives at the next one earlier
+    // The others are still waiting: what last() writes, they read once the round has moved. If
+    // it throws, run() records the error, which moves the round on with failed_ set.
+    if (last) last();
     rounds_.fetch_add(1);
     rounds_.notify_all();
   } else {
@@ -142,14 +148,17 @@ void ThreadTeam::work(int t) {
   }
 }
 
-void Barrier::wait() const {
-  if (!team_) return;
+void Barrier::wait(const std::function<void()>& last) const {
+  if (!team_) {
+    if (last) last();
+    return;
+  }
   if (!waited_) {
-    team_->sync();
+    team_->sync(last);
     return;
   }
   const auto start = std::chrono::steady_clock::now();
-  team_->sync();
+  team_->sync(last);
   *waited_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
 

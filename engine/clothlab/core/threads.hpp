@@ -42,7 +42,10 @@ class ThreadTeam {
   // as often as this one (a barrier within the job; no thread sleeps for it unless it waits
   // long). Every thread's job must call it the same number of times. If a job throws on one
   // thread, the others stop waiting here and end their jobs, and run() rethrows the error.
-  void sync();
+  // With `last`, the last thread to arrive calls last() before any thread leaves: work that must
+  // be done once, by one thread, between the two parts (the next step's time), at no second
+  // meeting. On one thread, last() is called at once. If it throws, the error is the job's.
+  void sync(const std::function<void()>& last = {});
 
   // The threads this machine can run at once (at least 1).
   static int hardware_threads();
@@ -112,12 +115,13 @@ bool balance_bounds(std::vector<Index>& bounds, const std::vector<double>& work,
                     Index max_shift, double tolerance);
 
 // What a range of for_ranges_with_barrier may wait at: wait() returns once every thread of the
-// job has reached it (ThreadTeam::sync); on one thread it returns at once.
+// job has reached it (ThreadTeam::sync); on one thread it returns at once. wait(last) calls
+// last() once, on the last thread to arrive, before any leaves (on one thread, at once).
 class Barrier {
  public:
   // waited: if not null, the seconds this thread spends in wait() are added there.
   explicit Barrier(ThreadTeam* team, double* waited = nullptr) : team_(team), waited_(waited) {}
-  void wait() const;
+  void wait(const std::function<void()>& last = {}) const;
 
  private:
   ThreadTeam* team_;
