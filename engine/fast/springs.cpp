@@ -235,6 +235,18 @@ void forces_in_vectors(Index count, Index nx, Index nv, const S* x1, const S* x2
   }
 }
 
+// The sums of `Blocks` consecutive blocks of `block` values from e: sums[q] = block q's values
+// added in order from +0.0, the blocks side by side (sums that do not wait on each other).
+template <int Blocks>
+void sums_of_blocks(const double* e, Index block, double* sums) {
+  double sum[Blocks] = {};
+  for (Index k = 0; k < block; ++k) {
+    for (int q = 0; q < Blocks; ++q)
+      sum[q] += e[q * block + k];
+  }
+  std::copy_n(sum, Blocks, sums);
+}
+
 }  // namespace
 
 void spring_forces_of_run(Index count, Index nx, Index nv, const double* x1, const double* x2,
@@ -454,7 +466,8 @@ class FastSprings final : public FastForceOf<S> {
       const Index n = static_cast<Index>(s.size());
       const Index block = static_cast<Index>(kEnergyBlock);
       const Index blocks = (n + block - 1) / block;
-      energies_.resize(s.size());
+      energies_.resize(static_cast<size_t>(blocks * block));
+      std::fill(energies_.begin() + n, energies_.end(), 0.0);  // the last block's tail
       block_sums_.assign(static_cast<size_t>(blocks), 0.0);
       block_summed_.assign(static_cast<size_t>(blocks), 0);
       // Block b's sum, its springs' energies added in order.
@@ -465,25 +478,22 @@ class FastSprings final : public FastForceOf<S> {
         block_sums_[static_cast<size_t>(b)] = sum;
         block_summed_[static_cast<size_t>(b)] = 1;
       };
-      // Blocks [b0, b1), each in order as sum_block does: four full blocks at a time, four sums
-      // that do not wait on each other (one addition after another is the loop's whole cost).
+      // Blocks [b0, b1), each in order as sum_block does: eight blocks at a time, eight sums that
+      // do not wait on each other (one addition after another is the loop's whole cost), then
+      // four, two and one. The last block, if short, counts as whole: its tail holds +0.0,
+      // which leaves a sum as it was (a sum of energies that starts at +0.0 is never -0.0).
       const auto sum_blocks = [&](Index b0, Index b1) {
-        const double* const e = energies_.data();
-        Index b = b0;
-        for (; b + 4 <= b1 && (b + 4) * block <= n; b += 4) {
-          const double* const e0 = e + b * block;
-          double sums[4] = {0.0, 0.0, 0.0, 0.0};
-          for (Index k = 0; k < block; ++k) {
-            for (Index q = 0; q < 4; ++q)
-              sums[q] += e0[q * block + k];
+        const auto group = [&](Index b, Index count, auto sum_group) {
+          for (; b + count <= b1; b += count) {
+            sum_group(energies_.data() + b * block, block, block_sums_.data() + b);
+            std::fill_n(block_summed_.begin() + b, count, 1);
           }
-          for (Index q = 0; q < 4; ++q) {
-            block_sums_[static_cast<size_t>(b + q)] = sums[q];
-            block_summed_[static_cast<size_t>(b + q)] = 1;
-          }
-        }
-        for (; b < b1; ++b)
-          sum_block(b);
+          return b;
+        };
+        Index b = group(b0, 8, sums_of_blocks<8>);
+        b = group(b, 4, sums_of_blocks<4>);
+        b = group(b, 2, sums_of_blocks<2>);
+        group(b, 1, sums_of_blocks<1>);
       };
       world.for_items(n, [&](Index begin, Index end) {
         // The runs cover the set in its order: the first that ends after `begin`, and on.
