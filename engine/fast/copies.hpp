@@ -95,11 +95,12 @@ class SoA3Pages {
 };
 
 // Where a copy's x, v and f start in a 4 KiB page, in cache lines (SoA3Pages::lay_out). With the
-// rows' spacing (kRowSpacing), the 18 rows of a run of steps' two copies (ResidentOf) each start
-// at a line of their own, at least 2 lines from any other: no two of a spring's inputs or
-// outputs share a place in the page by the layout's doing.
-inline constexpr Index kRowSpacing[3] = {21, 7, 49};  // lines between the rows of x, v and f
-inline constexpr std::array<int, 3> kFirstCopy{0, 38, 23}, kSecondCopy{5, 3, 28};  // x, v, f
+// rows' spacing (kRowSpacing), the 15 rows of a run of steps' two copies (ResidentOf: two of x
+// and v, one f) each start at a line of their own, at least 2 lines from any other: no two of a
+// spring's inputs or outputs share a place in the page by the layout's doing.
+inline constexpr Index kRowSpacing[3] = {21, 7, 49};        // lines between the rows of x, v and f
+inline constexpr std::array<int, 3> kFirstCopy{0, 38, 23};  // x, v, f
+inline constexpr std::array<int, 2> kSecondCopy{5, 3};      // x, v
 
 // The copies of positions, velocities and forces, kept by the fast engine between evaluations:
 // views of storage laid out by the engine room (SoA3Pages). Not copyable: a copy's views would
@@ -142,7 +143,9 @@ struct CopiesOf {
 using Copies = CopiesOf<double>;
 
 // The two copies of the state a run of steps takes turns with (resident.hpp): the one a step
-// reads, and the one its move writes, in one allocation.
+// reads, and the one its move writes, in one allocation. They share one f: a step clears and
+// sums each block's forces there and its move reads them, and the next step clears them only
+// once every thread has moved (the barrier between steps); the last step's forces stay.
 template <class Scalar>
 struct ResidentOf {
   CopiesOf<Scalar> a, b;
@@ -153,10 +156,10 @@ struct ResidentOf {
     const auto c = CopiesOf<Scalar>::columns(n);
     const auto& sa = kFirstCopy;
     const auto& sb = kSecondCopy;
-    const auto at = pages_.lay_out(std::array<Index, 6>{c[0], c[1], c[2], c[0], c[1], c[2]},
-                                   std::array<int, 6>{sa[0], sa[1], sa[2], sb[0], sb[1], sb[2]});
+    const auto at = pages_.lay_out(std::array<Index, 5>{c[0], c[1], c[2], c[0], c[1]},
+                                   std::array<int, 5>{sa[0], sa[1], sa[2], sb[0], sb[1]});
     a.bind(n, at[0], at[1], at[2]);
-    b.bind(n, at[3], at[4], at[5]);
+    b.bind(n, at[3], at[4], at[2]);
     n_ = n;
   }
 

@@ -281,23 +281,21 @@ TEST_CASE("advance: in float, the steps read the masses the particles have now")
 
 namespace {
 
-// Every row of `copies` (x, v and f of each) starts on a cache line; no two rows overlap, each
+// Every row of `arrays` (x, v or f of a copy) starts on a cache line; no two rows overlap, each
 // taken whole, its padding included; and no two of them start within `min_lines` lines of the
 // same place in a 4 KiB page.
 template <class S>
-void check_rows(const std::vector<const clothlab::fast::CopiesOf<S>*>& copies, Index n,
+void check_rows(const std::vector<const clothlab::fast::SoA3Of<S>*>& arrays, Index n,
                 int min_lines) {
   struct Row {
     std::uintptr_t begin, end;
   };
   std::vector<Row> rows;
-  for (const auto* c : copies) {
-    for (const auto* a : {&c->x, &c->v, &c->f}) {
-      REQUIRE(a->cols() >= n);
-      for (Index r = 0; r < 3; ++r) {
-        const auto begin = reinterpret_cast<std::uintptr_t>(a->data() + r * a->cols());
-        rows.push_back({begin, begin + static_cast<std::uintptr_t>(a->cols()) * sizeof(S)});
-      }
+  for (const auto* a : arrays) {
+    REQUIRE(a->cols() >= n);
+    for (Index r = 0; r < 3; ++r) {
+      const auto begin = reinterpret_cast<std::uintptr_t>(a->data() + r * a->cols());
+      rows.push_back({begin, begin + static_cast<std::uintptr_t>(a->cols()) * sizeof(S)});
     }
   }
   for (size_t i = 0; i < rows.size(); ++i) {
@@ -319,15 +317,16 @@ void check_layouts() {
     CAPTURE(n);
     clothlab::fast::CopiesOf<S> one;
     one.resize(n);
-    check_rows<S>({&one}, n, 2);
+    check_rows<S>({&one.x, &one.v, &one.f}, n, 2);
+    // A run of steps' two copies: two of x and v, and the one f they share.
     clothlab::fast::ResidentOf<S> two;
-    two.resize(n);
-    check_rows<S>({&two.a, &two.b}, n, 2);
-    // Smaller, then larger than before: laid out again, with the same guarantees.
-    two.resize(n / 2 + 1);
-    check_rows<S>({&two.a, &two.b}, n / 2 + 1, 2);
-    two.resize(2 * n);
-    check_rows<S>({&two.a, &two.b}, 2 * n, 2);
+    for (const Index m : {n, n / 2 + 1, 2 * n}) {  // then smaller, then larger: laid out again
+      CAPTURE(m);
+      two.resize(m);
+      check_rows<S>({&two.a.x, &two.a.v, &two.a.f, &two.b.x, &two.b.v}, m, 2);
+      CHECK(two.b.f.data() == two.a.f.data());
+      CHECK(two.b.f.cols() == two.a.f.cols());
+    }
   }
 }
 
