@@ -93,6 +93,60 @@ template <class Collider>
   collider.collide(p, begin, end);
 }
 
+// The contacts of a run of steps (FastEngine::steps) on particles [begin, end): each contact in
+// the world's order, over the particles, as Ground::collide and Sphere::collide take them (their
+// contact() on each free particle inside), from the state the move left in the next copies
+// (x_out, v_out) and the step's start in the copies it read (x0, v0: what the effects'
+// before_step records). Returns whether any particle met one. `flatten`, as collide_range, for
+// the exercise's kernel. A particle above the ground is tested on its height alone (contact()
+// finds the same), without loading the rest of its state.
+[[gnu::noinline, gnu::flatten]] bool contacts_resident(
+    Index begin, Index end, const std::vector<Contact>& contacts, const double* __restrict inv_m,
+    const double* __restrict x0, Index nx0, const double* __restrict v0, Index nv0,
+    double* __restrict x_out, Index nxo, double* __restrict v_out, Index nvo) {
+  bool met = false;
+  const auto meet = [&](Index i, const auto& collider) {
+    Vec3 x(x_out[i], x_out[nxo + i], x_out[2 * nxo + i]);
+    Vec3 v(v_out[i], v_out[nvo + i], v_out[2 * nvo + i]);
+    const Vec3 start_x(x0[i], x0[nx0 + i], x0[2 * nx0 + i]);
+    const Vec3 start_v(v0[i], v0[nv0 + i], v0[2 * nv0 + i]);
+    if (!collider.contact(x, v, true, start_x, start_v)) return;
+    for (int c = 0; c < 3; ++c) {
+      x_out[c * nxo + i] = x[c];
+      v_out[c * nvo + i] = v[c];
+    }
+    met = true;
+  };
+  for (const Contact& contact : contacts) {
+    if (contact.ground) {
+      const double y0 = contact.ground->y0();
+      for (Index i = begin; i < end; ++i) {
+        if (y0 - x_out[nxo + i] > 0.0 && inv_m[i] != 0.0) meet(i, *contact.ground);
+      }
+    }
+    if (contact.sphere) {
+      for (Index i = begin; i < end; ++i) {
+        if (inv_m[i] != 0.0) meet(i, *contact.sphere);
+      }
+    }
+  }
+  return met;
+}
+
+// Guard::within on particles [begin, end) of the copies' rows x and v (as move_particles_resident
+// tests them).
+bool within_rows(Index begin, Index end, const double* x, Index nx, const double* v, Index nv,
+                 double max_position, double max_speed) {
+  long outside = 0;
+  for (int c = 0; c < 3; ++c) {
+    for (Index i = begin; i < end; ++i) {
+      outside +=
+          !(std::abs(x[c * nx + i]) <= max_position) + !(std::abs(v[c * nv + i]) <= max_speed);
+    }
+  }
+  return outside == 0;
+}
+
 // The Euler methods' one-particle kernels, each a type of its own, so that every loop given one
 // is compiled for it, the kernel inlined: the step's pass (euler_move) and a run of steps
 // (FastEngine::steps) call the same two.
@@ -233,10 +287,24 @@ BackendStep FastEngine::step(World& world, double dt) {
 }
 
 BackendSteps FastEngine::steps(World& world, double dt, long count) {
-  if (count <= 0 || !world.post_step_effects.empty()) return {};
+  if (count <= 0) return {};
   if (precision == Precision::float32) {
     if (!float_room_) float_room_ = std::make_shared<FloatRoom>();
     return float_room_->steps(world, dt, count);
+  }
+  // Post-step effects ride along only if all are contacts (the ground, spheres): each moved
+  // particle meets them in the world's order, from the state the step began with, which the
+  // copies the step reads still hold. Any other (moving pins, tearing, a plane) needs the
+  // world's layout between two steps: the world takes them one at a time.
+  resident_contacts_.clear();
+  for (const auto& effect : world.post_step_effects) {
+    if (auto* ground = dynamic_cast<Ground*>(effect.get())) {
+      resident_contacts_.push_back({ground, nullptr});
+    } else if (auto* sphere = dynamic_cast<Sphere*>(effect.get())) {
+      resident_contacts_.push_back({nullptr, sphere});
+    } else {
+      return {};
+    }
   }
   const Integrator* integrator = world.integrator.get();
   const bool explicit_euler = dynamic_cast<const ExplicitEuler*>(integrator) != nullptr;
@@ -250,12 +318,21 @@ BackendSteps FastEngine::steps(World& world, double dt, long count) {
     for (const Force& force : forces_)
       force.fast->add(p, x, v, f, b0, b1);
   };
+  const double max_position = world.guard.max_position, max_speed = world.guard.max_speed;
   const auto moves = [&](auto kernel) {
     return [&, kernel](Index c0, Index c1, const Copies& now, Copies& next) {
-      return move_particles_resident(c0, c1, dt, kernel, now.x.data(), now.x.cols(), now.v.data(),
-                                     now.v.cols(), now.f.data(), now.f.cols(), p.inv_m.data(),
-                                     next.x.data(), next.x.cols(), next.v.data(), next.v.cols(),
-                                     world.guard.max_position, world.guard.max_speed);
+      const bool within = move_particles_resident(
+          c0, c1, dt, kernel, now.x.data(), now.x.cols(), now.v.data(), now.v.cols(), now.f.data(),
+          now.f.cols(), p.inv_m.data(), next.x.data(), next.x.cols(), next.v.data(), next.v.cols(),
+          max_position, max_speed);
+      if (resident_contacts_.empty()) return within;
+      if (!contacts_resident(c0, c1, resident_contacts_, p.inv_m.data(), now.x.data(), now.x.cols(),
+                             now.v.data(), now.v.cols(), next.x.data(), next.x.cols(),
+                             next.v.data(), next.v.cols()))
+        return within;  // nothing met them: the move's state, as it tested it
+      // The guard's test after the contacts, on the state they leave.
+      return within_rows(c0, c1, next.x.data(), next.x.cols(), next.v.data(), next.v.cols(),
+                         max_position, max_speed);
     };
   };
   const Index block = std::max<Index>(pass_block, 1);

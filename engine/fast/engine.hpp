@@ -92,6 +92,13 @@ inline constexpr Index kPassChunk = 512;
 // per block (32 for a 256-wide cloth). SPEED.md has the measurements behind the size.
 inline constexpr Index kPassBlock = 8192;
 
+// A post-step effect that rides along in the engine room's step: a contact, which changes each
+// particle from its own state alone (Ground::contact, Sphere::contact).
+struct Contact {
+  const Ground* ground = nullptr;
+  const Sphere* sphere = nullptr;
+};
+
 struct ImplicitSolver;
 struct LocalGlobalRoom;  // local_global.cpp
 class FloatRoom;         // float_room.hpp
@@ -197,12 +204,9 @@ class FastEngine final : public Backend {
     bool on = false;  // it takes the current evaluation
   };
   std::vector<Force> forces_;
-  struct Contact {  // a leading post-step effect that rides along in a step's pass
-    const Ground* ground = nullptr;
-    const Sphere* sphere = nullptr;
-  };
-  std::vector<Contact> contacts_;
+  std::vector<Contact> contacts_;   // the leading post-step effects that ride along in a pass
   std::vector<StepStart*> starts_;  // theirs (PassChecks::starts)
+  std::vector<Contact> resident_contacts_;  // every post-step effect of a run of steps
   Copies copies_;
   ResidentOf<double> resident_;   // steps' two copies of the state
   SoA3Matrix xpbd_x_, xpbd_old_;  // x and x_old in the fast layout, for XPBD's projections

@@ -71,34 +71,42 @@ void Ground::apply(World& world, const StepTime& /*time*/) {
 // the contact: the exercise's collision_response (ex05.1) for the Coulomb model, the lecture's
 // mirror for the simple one.
 void Ground::collide(Particles& p, Index begin, Index end) const {
-  const Vec3 up = Vec3::UnitY();
+  const bool known = start_.known(p);
   for (Index i = begin; i < end; ++i) {
-    const double depth = y0_ - p.x(1, i);
-    if (!(depth > 0.0) || p.inv_m[i] == 0.0) continue;  // above the ground, or pinned
-    if (model_ == Model::simple) {
-      // The lecture's version: mirror the penetration, bounce, scale the sliding velocity.
-      p.x(1, i) = y0_ + depth;
-      p.v(1, i) = -material_.e * p.v(1, i);
-      p.v(0, i) *= 1.0 - friction_;
-      p.v(2, i) *= 1.0 - friction_;
-      continue;
-    }
-    const Vec3 x1 = p.x.col(i);
-    const Vec3 v1 = p.v.col(i);
-    const bool known = start_.known(p);
-    const double height0 = known ? start_.x(i).y() - y0_ : 1.0;  // where the step began
-    const PointState out =
-        respond(x1, v1, up, depth, material_, known && touching(height0, start_.x(i)),
-                known ? start_.v(i) : v1);
-    p.x.col(i) = out.r;
-    p.v.col(i) = out.v;
-    if (known && held(v1, out.v, up)) {
-      const Vec3 met = where_it_met(start_.x(i), x1, height0, depth);
-      p.x(0, i) = met.x();
-      p.x(2, i) = met.z();
-    }
-    p.x(1, i) = std::max(p.x(1, i), y0_);  // exactly on the ground, whatever the rounding
+    if (p.inv_m[i] == 0.0) continue;  // pinned
+    Vec3 x = p.x.col(i), v = p.v.col(i);
+    if (!contact(x, v, known, known ? start_.x(i) : x, known ? start_.v(i) : v)) continue;
+    p.x.col(i) = x;
+    p.v.col(i) = v;
   }
+}
+
+bool Ground::contact(Vec3& x, Vec3& v, bool known, const Vec3& x0, const Vec3& v0) const {
+  const double depth = y0_ - x.y();
+  if (!(depth > 0.0)) return false;  // above the ground
+  if (model_ == Model::simple) {
+    // The lecture's version: mirror the penetration, bounce, scale the sliding velocity.
+    x.y() = y0_ + depth;
+    v.y() = -material_.e * v.y();
+    v.x() *= 1.0 - friction_;
+    v.z() *= 1.0 - friction_;
+    return true;
+  }
+  const Vec3 up = Vec3::UnitY();
+  const Vec3 x1 = x;
+  const Vec3 v1 = v;
+  const double height0 = known ? x0.y() - y0_ : 1.0;  // where the step began
+  const PointState out =
+      respond(x1, v1, up, depth, material_, known && touching(height0, x0), known ? v0 : v1);
+  x = out.r;
+  v = out.v;
+  if (known && held(v1, out.v, up)) {
+    const Vec3 met = where_it_met(x0, x1, height0, depth);
+    x.x() = met.x();
+    x.z() = met.z();
+  }
+  x.y() = std::max(x.y(), y0_);  // exactly on the ground, whatever the rounding
+  return true;
 }
 
 void Sphere::apply(World& world, const StepTime& /*time*/) {
@@ -106,28 +114,36 @@ void Sphere::apply(World& world, const StepTime& /*time*/) {
 }
 
 void Sphere::collide(Particles& p, Index begin, Index end) const {
+  const bool known = start_.known(p);
   for (Index i = begin; i < end; ++i) {
-    const Vec3 d = p.x.col(i) - centre_;
-    const double distance = d.norm();
-    if (!(distance < radius_) || p.inv_m[i] == 0.0) continue;
-    // The outward normal; a particle exactly at the centre is pushed out upward.
-    const Vec3 n = distance > 0.0 ? Vec3(d / distance) : Vec3::UnitY();
-    const Vec3 x1 = p.x.col(i);
-    const Vec3 v1 = p.v.col(i);
-    const bool known = start_.known(p);
-    const double height0 = known ? (start_.x(i) - centre_).norm() - radius_ : 1.0;
-    const PointState out =
-        respond(x1, v1, n, radius_ - distance, material_, known && touching(height0, start_.x(i)),
-                known ? start_.v(i) : v1);
-    p.x.col(i) = out.r;
-    p.v.col(i) = out.v;
-    if (known && held(v1, out.v, n)) {
-      const Vec3 met = where_it_met(start_.x(i), x1, height0, radius_ - distance);
-      const Vec3 from_centre = met - centre_;
-      const double r = from_centre.norm();
-      if (r > 0.0) p.x.col(i) = centre_ + radius_ / r * from_centre;
-    }
+    if (p.inv_m[i] == 0.0) continue;  // pinned
+    Vec3 x = p.x.col(i), v = p.v.col(i);
+    if (!contact(x, v, known, known ? start_.x(i) : x, known ? start_.v(i) : v)) continue;
+    p.x.col(i) = x;
+    p.v.col(i) = v;
   }
+}
+
+bool Sphere::contact(Vec3& x, Vec3& v, bool known, const Vec3& x0, const Vec3& v0) const {
+  const Vec3 d = x - centre_;
+  const double distance = d.norm();
+  if (!(distance < radius_)) return false;
+  // The outward normal; a particle exactly at the centre is pushed out upward.
+  const Vec3 n = distance > 0.0 ? Vec3(d / distance) : Vec3::UnitY();
+  const Vec3 x1 = x;
+  const Vec3 v1 = v;
+  const double height0 = known ? (x0 - centre_).norm() - radius_ : 1.0;
+  const PointState out = respond(x1, v1, n, radius_ - distance, material_,
+                                 known && touching(height0, x0), known ? v0 : v1);
+  x = out.r;
+  v = out.v;
+  if (known && held(v1, out.v, n)) {
+    const Vec3 met = where_it_met(x0, x1, height0, radius_ - distance);
+    const Vec3 from_centre = met - centre_;
+    const double r = from_centre.norm();
+    if (r > 0.0) x = centre_ + radius_ / r * from_centre;
+  }
+  return true;
 }
 
 void Plane::apply(World& world, const StepTime& /*time*/) {

@@ -78,6 +78,11 @@ class Ground final : public PostStepEffect {
   // apply's loop on particles [begin, end) only: each particle is pushed out from its own state
   // alone, so ranges may be taken apart (and by different threads at once).
   void collide(Particles& p, Index begin, Index end) const;
+  // collide's response for one free particle: x and v, where the step left it, put back on the
+  // ground and answering the contact if it is below; x0 and v0, its state when the step began
+  // (used if `known`). Returns whether it was below. A backend that keeps the state in a layout
+  // of its own (a run of steps, fast/resident.hpp) calls it with the same values.
+  bool contact(Vec3& x, Vec3& v, bool known, const Vec3& x0, const Vec3& v0) const;
   // What before_step records, for a backend that records it itself (World::record_step_start).
   StepStart& step_start() { return start_; }
   double y0() const { return y0_; }
@@ -123,6 +128,8 @@ class Sphere final : public PostStepEffect {
   void apply(World& world, const StepTime& time) override;
   // apply's loop on particles [begin, end) only (as Ground::collide).
   void collide(Particles& p, Index begin, Index end) const;
+  // collide's response for one free particle, as Ground::contact: whether it was inside.
+  bool contact(Vec3& x, Vec3& v, bool known, const Vec3& x0, const Vec3& v0) const;
   // What before_step records, for a backend that records it itself (World::record_step_start).
   StepStart& step_start() { return start_; }
   const Vec3& centre() const { return centre_; }

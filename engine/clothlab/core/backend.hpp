@@ -59,8 +59,9 @@ class Backend {
   // (the same bits): every force effect's set_time(world.t), the forces summed, every particle
   // moved, the state checked, then world.t += dt and ++world.steps. Between two of them the state
   // may stay in the backend's own layout; after the last, the world's particles hold it (x, v and
-  // f, as after World::step). World::advance asks only for a world whose guard has started, with
-  // no post-step effect and no timer, and for no more steps than reach the guard's next energy
+  // f, as after World::step), and a post-step effect, if the backend takes a world that has one,
+  // has done to each step what World::step has it do. World::advance asks only for a world whose
+  // guard has started, with no timer, and for no more steps than reach the guard's next energy
   // check. A state that fails the guard's test before the first step throws the guard's error
   // before anything moves; a step that leaves one is the last taken (within false: the world
   // then lets the guard throw). {} declines: nothing changed, not even the effects' time.

@@ -59,9 +59,9 @@ void World::step(double dt) {
 
 void World::advance(double dt, long count) {
   while (count > 0) {
-    // The first step starts the guard; a timed step (--stats) and a post-step effect stay the
-    // world's own.
-    if (steps == 0 || !backend || timer || !post_step_effects.empty()) {
+    // The first step starts the guard; a timed step (--stats) stays the world's own, and so do
+    // the steps of a world whose post-step effects the backend cannot take (it declines).
+    if (steps == 0 || !backend || timer) {
       step(dt);
       --count;
       continue;
