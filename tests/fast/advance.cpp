@@ -204,8 +204,8 @@ TEST_CASE("advance: a state bad before the steps is the guard's error, and nothi
 namespace {
 
 // A sheet dropped flat onto a ball standing on the ground (lesson 05's cloth-on-sphere, coarser):
-// by 2 s its middle rests on the ball, held there by static friction, its skirt slides down
-// the sides and its corners land on the floor, and bounce, with the given ground model.
+// by 2 s its middle rests on the ball and its corners have come down to the floor, with the
+// given ground model.
 std::string draped_cloth(const std::string& ground) {
   return R"([cloth]
 rows = 16
@@ -242,8 +242,8 @@ duration = 1.0
 TEST_CASE("advance: the ground and spheres ride along in a run of steps, bit for bit") {
   // Each moved particle meets the contacts in the world's order, from the state its step began
   // with (the copies the step read): the state, forces, time and counts of step() one at a time
-  // on the lecture's path, after 4000 steps in which particles land, bounce, rest, are held by
-  // static friction and slide, on a ball and on the ground.
+  // on the lecture's path, after 4000 steps in which particles land on a ball and on the
+  // ground.
   for (const std::string ground :
        {"e = 0.3\nmu_s = 0.5\nmu_d = 0.4", "model = \"simple\"\ne = 0.3\nfriction = 0.2"}) {
     CAPTURE(ground);
@@ -272,8 +272,8 @@ TEST_CASE("advance: the ground and spheres ride along in a run of steps, bit for
 TEST_CASE("advance: in a run of steps, the guard tests the state the contacts leave") {
   // A particle thrown down at 1000 m/s: step 1 (the world's own) takes it to y = -0.1 m; step 2,
   // the run's first, to -1.1 m, past the guard's 1 m, but the ground at -0.5 m puts it back on
-  // itself, and the step stands, as after World::step, whose guard looks after the contacts. The
-  // bounce (e = 0.3) then carries it up past 1 m a few steps later, where both stop alike.
+  // its surface, and the step stands, as after World::step, whose guard looks after the contacts.
+  // The bounce (e = 0.3) then carries it up past 1 m a few steps later, where both stop alike.
   const std::string text = R"([[particle]]
 position = [0.0, 0.9, 0.0]
 velocity = [0.0, -1000.0, 0.0]
