@@ -258,11 +258,12 @@ struct StepBytes {
 };
 
 // From the engine room's layout (fast/engine.cpp, fast/copies.hpp, fast/springs.cpp), for a cloth
-// of springs and gravity moved by symplectic Euler:
-//   per particle: x and v read and written in the engine's layout (4 x 24 bytes), f written
-//     (24), 1/m read by the move (8), m read by gravity (8): 136 bytes moved. The step also
-//     writes copies of x, v and f in the structure-of-arrays layout and reads them back (72
-//     bytes, 216 moved if they leave the cache between the two): touched, not counted as moved;
+// of springs and gravity moved by symplectic Euler in runs of steps (fast/resident.hpp), as
+// bench speed and this bench step it:
+//   per particle: x and v read from one copy and written to the other (4 x 24 bytes), f written
+//     (24; the move reads it back), 1/m read by the move (8), m read by gravity (8): 136 bytes
+//     moved, and as many touched, every array once (the two copies of x and v, their one f). The
+//     world's own layout is read and written once a run, every 32 steps: not counted;
 //   per spring: its l0 (8 bytes); and its ks and kd (16) unless its run is uniform, whose ks and
 //     kd are read once for the run (16 bytes a run). A grid stencil's springs (fast/springs.hpp)
 //     read their ks and kd once (16), and their rest lengths from its distinct rows of them
@@ -272,7 +273,7 @@ StepBytes step_bytes(const World& world) {
   b.particles = static_cast<long>(world.particles.size());
   const double p = static_cast<double>(b.particles);
   b.moved = 4 * 24 * p + 24 * p + 8 * p;
-  b.touched = (3 * 24 + 8 + 3 * 24) * p;
+  b.touched = (4 * 24 + 24 + 8) * p;
   for (const auto& effect : world.force_effects) {
     if (dynamic_cast<const UniformGravity*>(effect.get())) {
       b.moved += 8 * p;
