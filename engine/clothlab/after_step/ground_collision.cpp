@@ -46,6 +46,22 @@ bool touching(double height0, const Vec3& x0) {
   return height0 <= 1e-12 * (1.0 + x0.lpNorm<Eigen::Infinity>());
 }
 
+// The loop of Ground::collide and Sphere::collide: each free particle of [begin, end) through
+// surface.contact (put back out if it is inside), with the state the step began with when
+// `start` knows it.
+template <class Surface>
+void collide_each(const Surface& surface, const StepStart& start, Particles& p, Index begin,
+                  Index end) {
+  const bool known = start.known(p);
+  for (Index i = begin; i < end; ++i) {
+    if (p.inv_m[i] == 0.0) continue;  // pinned
+    Vec3 x = p.x.col(i), v = p.v.col(i);
+    if (!surface.contact(x, v, known, known ? start.x(i) : x, known ? start.v(i) : v)) continue;
+    p.x.col(i) = x;
+    p.v.col(i) = v;
+  }
+}
+
 }  // namespace
 
 void StepStart::record(const World& world) {
@@ -71,14 +87,7 @@ void Ground::apply(World& world, const StepTime& /*time*/) {
 // the contact: the exercise's collision_response (ex05.1) for the Coulomb model, the lecture's
 // mirror for the simple one.
 void Ground::collide(Particles& p, Index begin, Index end) const {
-  const bool known = start_.known(p);
-  for (Index i = begin; i < end; ++i) {
-    if (p.inv_m[i] == 0.0) continue;  // pinned
-    Vec3 x = p.x.col(i), v = p.v.col(i);
-    if (!contact(x, v, known, known ? start_.x(i) : x, known ? start_.v(i) : v)) continue;
-    p.x.col(i) = x;
-    p.v.col(i) = v;
-  }
+  collide_each(*this, start_, p, begin, end);
 }
 
 bool Ground::contact(Vec3& x, Vec3& v, bool known, const Vec3& x0, const Vec3& v0) const {
@@ -114,14 +123,7 @@ void Sphere::apply(World& world, const StepTime& /*time*/) {
 }
 
 void Sphere::collide(Particles& p, Index begin, Index end) const {
-  const bool known = start_.known(p);
-  for (Index i = begin; i < end; ++i) {
-    if (p.inv_m[i] == 0.0) continue;  // pinned
-    Vec3 x = p.x.col(i), v = p.v.col(i);
-    if (!contact(x, v, known, known ? start_.x(i) : x, known ? start_.v(i) : v)) continue;
-    p.x.col(i) = x;
-    p.v.col(i) = v;
-  }
+  collide_each(*this, start_, p, begin, end);
 }
 
 bool Sphere::contact(Vec3& x, Vec3& v, bool known, const Vec3& x0, const Vec3& v0) const {
