@@ -3,10 +3,12 @@
 // The scene: an N x N cloth, 1 cm apart, hanging from its two top corners, with structural,
 // shear and bending springs, gravity and symplectic Euler, for N in {32, 64, 128, 256}. Every
 // figure is the median over repeats of the wall time of many steps, per spring and step, and
-// every variant runs in the same process, one after the other, so that ratios compare like
-// with like:
+// every variant runs in the same process, the variants taking turns repeat by repeat, so that
+// ratios compare like with like; a ratio the run prints is taken turn by turn (ratio_of_turns),
+// the median of the repeats' ratios, with their range:
 //
-//   reference       the engine's own step (the fast path), on 1 thread and on every core
+//   reference       the engine's own step (the fast path), on 1 thread and on every core, with
+//                   the speed-up of every core over one
 //   float           the same step in single precision ([engine] precision = "float", the float
 //                   room), 1 thread and every core, with its time over reference's of the same
 //                   run and its distance from reference after 20 steps
@@ -197,6 +199,20 @@ double median(std::vector<double> samples) {
   std::sort(samples.begin(), samples.end());
   const size_t mid = samples.size() / 2;
   return samples.size() % 2 == 1 ? samples[mid] : 0.5 * (samples[mid - 1] + samples[mid]);
+}
+
+// a's time over b's, turn by turn: each repeat times a and b within a second of each other, so
+// the ratio of one repeat's pair leaves out whatever slowed the machine from one repeat to the
+// next, which the ratio of the two medians keeps. Printed as the median of the repeats' ratios,
+// and with several repeats, their range: how far one run's ratio can be trusted.
+std::string ratio_of_turns(const std::vector<double>& a, const std::vector<double>& b) {
+  std::vector<double> ratios;
+  for (size_t r = 0; r < std::min(a.size(), b.size()); ++r)
+    ratios.push_back(a[r] / b[r]);
+  if (ratios.size() < 2) return fmt::format("{:.2f}", ratios.empty() ? 0.0 : ratios[0]);
+  const auto [lo, hi] = std::minmax_element(ratios.begin(), ratios.end());
+  return fmt::format("{:.2f} ({:.2f} to {:.2f} in {} turns)", median(ratios), *lo, *hi,
+                     ratios.size());
 }
 
 Measurement make_row(const std::string& variant, int n, int threads, long springs, double seconds,
@@ -756,28 +772,34 @@ void measure_size(int n, int all_cores, const SpeedOptions& opt, std::vector<Mea
     const Contender& c = contenders[k];
     rows.push_back(make_row(c.variant, n, c.threads, c.springs, median(c.samples), notes[k]));
   }
-  // A float step over its double step on as many threads, both measured in this run: float
-  // over reference, float+aerodynamics over +aerodynamics.
-  for (size_t k = first_row; k < rows.size(); ++k) {
-    if (rows[k].variant.rfind("float", 0) != 0) continue;
-    const std::string twin = rows[k].variant == "float" ? "reference" : rows[k].variant.substr(5);
-    for (size_t r = first_row; r < rows.size(); ++r) {
-      if (rows[r].variant == twin && rows[r].threads == rows[k].threads) {
-        rows[k].note =
-            fmt::format("{} / {} {:.2f}; {}", rows[k].variant, twin,
-                        rows[k].ns_per_spring_step / rows[r].ns_per_spring_step, rows[k].note);
+  // The ratios of this run, turn by turn (ratio_of_turns): contenders k and r are rows
+  // first_row + k and first_row + r.
+  const auto ratio = [&](size_t k, size_t r) {
+    return ratio_of_turns(contenders[k].samples, contenders[r].samples);
+  };
+  // A float step over its double step on as many threads: float over reference,
+  // float+aerodynamics over +aerodynamics.
+  for (size_t k = 0; k < contenders.size(); ++k) {
+    if (contenders[k].variant.rfind("float", 0) != 0) continue;
+    const std::string twin =
+        contenders[k].variant == "float" ? "reference" : contenders[k].variant.substr(5);
+    for (size_t r = 0; r < contenders.size(); ++r) {
+      if (contenders[r].variant == twin && contenders[r].threads == contenders[k].threads) {
+        Measurement& row = rows[first_row + k];
+        row.note = fmt::format("{} / {} {}; {}", row.variant, twin, ratio(k, r), row.note);
       }
     }
   }
-  // The engine's one-thread step over the plain loops', both measured in this run.
-  for (size_t k = first_row; k < rows.size(); ++k) {
-    if (rows[k].variant != "plain") continue;
-    for (size_t r = first_row; r < rows.size(); ++r) {
-      if (rows[r].variant == "reference" && rows[r].threads == 1) {
-        rows[k].note =
-            fmt::format("reference / plain {:.2f}; {}",
-                        rows[r].ns_per_spring_step / rows[k].ns_per_spring_step, rows[k].note);
-      }
+  // The engine's one-thread step over the plain loops'; the engine on every core against one.
+  for (size_t k = 0; k < contenders.size(); ++k) {
+    const bool anchor = contenders[k].variant == "plain";
+    const bool threads = contenders[k].variant == "reference" && contenders[k].threads > 1;
+    if (!anchor && !threads) continue;
+    for (size_t r = 0; r < contenders.size(); ++r) {
+      if (contenders[r].variant != "reference" || contenders[r].threads != 1) continue;
+      Measurement& row = rows[first_row + k];
+      row.note = anchor ? fmt::format("reference / plain {}; {}", ratio(r, k), row.note)
+                        : fmt::format("speed-up over 1 thread {}", ratio(r, k));
     }
   }
   if (implicit) {

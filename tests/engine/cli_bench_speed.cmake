@@ -66,6 +66,28 @@ foreach(pair "float;reference" "float\\+aerodynamics;\\+aerodynamics")
     endif()
   endforeach()
 endforeach()
+# With several repeats, each ratio of the run is taken turn by turn (the two rows' times of one
+# repeat, measured within a second of each other) and printed as the median of those ratios with
+# their range: float over reference, reference over plain, and 1 thread over 2 (the speed-up).
+execute_process(COMMAND ${CLOTHLAB} bench speed --sizes 16 --variants reference,float,plain
+                        --threads 2 --repeats 3 --min-seconds 0.01 --no-student
+                WORKING_DIRECTORY ${WORK}
+                RESULT_VARIABLE code OUTPUT_VARIABLE turns ERROR_VARIABLE err)
+if(NOT code EQUAL 0)
+  message(FATAL_ERROR "bench speed --repeats 3 failed with ${code}\n${turns}${err}")
+endif()
+set(number "([0-9]+\\.[0-9]+)")
+foreach(pattern "float +1 [^\n]*float / reference ${number} \\(${number} to ${number} in 3 turns\\); "
+                "plain +1 [^\n]*reference / plain ${number} \\(${number} to ${number} in 3 turns\\); "
+                "reference +2 [^\n]*speed-up over 1 thread ${number} \\(${number} to ${number} in 3 turns\\)")
+  if(NOT turns MATCHES "${pattern}")
+    message(FATAL_ERROR "no ratio taken turn by turn, with its range, matching\n  ${pattern}\nin:\n${turns}")
+  endif()
+  # The median of three ratios lies within their range.
+  if(CMAKE_MATCH_2 GREATER CMAKE_MATCH_1 OR CMAKE_MATCH_1 GREATER CMAKE_MATCH_3)
+    message(FATAL_ERROR "a median outside its range: ${CMAKE_MATCH_0}")
+  endif()
+endforeach()
 # The shipped stubs cannot run the scene: the student row is skipped, naming the exercise.
 if(NOT out MATCHES "student: skipped: (ex[0-9][0-9]\\.[0-9] is not done|clothlab-student was not found)"
    AND NOT "student" IN_LIST variants)
