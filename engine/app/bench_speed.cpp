@@ -201,9 +201,10 @@ double median(std::vector<double> samples) {
   return samples.size() % 2 == 1 ? samples[mid] : 0.5 * (samples[mid - 1] + samples[mid]);
 }
 
-// a's time over b's, turn by turn: each repeat times a and b within a second of each other, so
-// the ratio of one repeat's pair leaves out whatever slowed the machine from one repeat to the
-// next, which the ratio of the two medians keeps. Printed as the median of the repeats' ratios,
+// a's time over b's, turn by turn: each repeat times a and b one soon after the other (the
+// contenders between them take a fraction of a second each), so the ratio of one repeat's pair
+// leaves out whatever slowed the machine from one repeat to the next, which the ratio of the two
+// medians keeps. Printed as the median of the repeats' ratios,
 // and with several repeats, their range: how far one run's ratio can be trusted.
 std::string ratio_of_turns(const std::vector<double>& a, const std::vector<double>& b) {
   std::vector<double> ratios;

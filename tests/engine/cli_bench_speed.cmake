@@ -67,7 +67,7 @@ foreach(pair "float;reference" "float\\+aerodynamics;\\+aerodynamics")
   endforeach()
 endforeach()
 # With several repeats, each ratio of the run is taken turn by turn (the two rows' times of one
-# repeat, measured within a second of each other) and printed as the median of those ratios with
+# repeat, measured one soon after the other) and printed as the median of those ratios with
 # their range: float over reference, reference over plain, and 1 thread over 2 (the speed-up).
 execute_process(COMMAND ${CLOTHLAB} bench speed --sizes 16 --variants reference,float,plain
                         --threads 2 --repeats 3 --min-seconds 0.01 --no-student
